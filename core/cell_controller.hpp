@@ -1,0 +1,20 @@
+// Interface of the stage that sets the cell's velocity gradient L from the measured state after each
+// force pass (servo control, strain-rate control, constant volume ...). Implementations live with the
+// loading protocols; the engine only calls update() once per step, between the force pass and the next
+// drift, so commands take effect on the next step.
+#pragma once
+
+#include "types.hpp"
+
+namespace fl {
+
+class Simulation;
+
+class CellController {
+ public:
+  virtual ~CellController() = default;
+  // Returns the velocity gradient L [1/s] for the next step.
+  virtual Mat3 update(const Simulation& sim) = 0;
+};
+
+}  // namespace fl

@@ -1,0 +1,438 @@
+#include "simulation.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "contact_kernels.hpp"
+#include "errors.hpp"
+#include "neighbor_search.hpp"
+
+namespace fl {
+
+namespace {
+constexpr std::size_t kChunk = 1024;  // fixed reduction block: results independent of thread count
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+}  // namespace
+
+// Partial sums of one fixed block of pairs (or particles), reduced in block order.
+struct Simulation::Chunk {
+  Mat3 stress = Mat3::Zero();  // sum f (x) l [N m]
+  double elasticN = 0.0, elasticT = 0.0, friction = 0.0, damping = 0.0, localDamping = 0.0;
+  double sumForce = 0.0, maxOverlapRatio = 0.0, maxKOverM = 0.0;
+  std::size_t contacts = 0, sliding = 0;
+  char pad[64] = {};  // keep neighbouring chunks on separate cache lines
+};
+
+const char* stageName(Stage s) {
+  switch (s) {
+    case Stage::Drift: return "drift";
+    case Stage::Neighbours: return "neighbours";
+    case Stage::Contacts: return "contacts";
+    case Stage::Kick: return "kick";
+    case Stage::Control: return "control";
+    default: return "?";
+  }
+}
+
+double StageProfile::total() const {
+  double t = 0.0;
+  for (double s : seconds) t += s;
+  return t;
+}
+
+Simulation::Simulation(ParticleStore particles, PeriodicCell cell, std::vector<Material> materials,
+                       NumericsSettings numerics)
+    : m_p(std::move(particles)), m_cell(std::move(cell)), m_materials(std::move(materials)), m_num(numerics) {
+  m_num.validate();
+  if (m_materials.empty()) throw InputError("simulation: at least one material is required");
+  if (m_p.size() < 1) throw InputError("simulation: no particles");
+  for (std::size_t i = 0; i < m_p.size(); ++i)
+    if (m_p.material[i] >= m_materials.size())
+      throw InputError("simulation: particle " + std::to_string(i) + " names material " +
+                       std::to_string(m_p.material[i]) + " but only " + std::to_string(m_materials.size()) +
+                       " are defined");
+  m_pairs = PairTable(m_materials, m_num.restitution);
+  // density scaling multiplies mass and inertia: divide the inverses
+  if (m_num.densityScale != 1.0)
+    for (std::size_t i = 0; i < m_p.size(); ++i) {
+      m_p.invMass[i] /= m_num.densityScale;
+      m_p.invInertia[i] /= m_num.densityScale;
+    }
+  m_rayleigh = rayleighTimeStep(m_p, m_materials, m_num.densityScale);
+  m_dt = m_num.timeStep > 0.0 ? m_num.timeStep : m_num.timeStepFactor * m_rayleigh;
+  double meanD = 0.0;
+  for (double r : m_p.radius) meanD += 2.0 * r;
+  meanD /= static_cast<double>(m_p.size());
+  m_skin = m_num.skin > 0.0 ? m_num.skin : 0.1 * meanD;
+  m_cutoff = 2.0 * m_p.maxRadius() + m_skin;
+  refresh();
+}
+
+Simulation::~Simulation() = default;
+Simulation::Simulation(Simulation&&) noexcept = default;
+Simulation& Simulation::operator=(Simulation&&) noexcept = default;
+
+void Simulation::setFriction(double mu) {
+  if (!(mu >= 0.0)) throw InputError("friction must be >= 0, got " + std::to_string(mu));
+  for (auto& m : m_materials) m.friction = mu;
+  m_pairs.setFriction(mu);
+}
+
+void Simulation::setTimeStep(double dt) {
+  if (!(dt > 0.0)) throw InputError("time step must be > 0 s");
+  m_dt = dt;
+}
+
+void Simulation::setLocalDamping(double alpha) {
+  if (!(alpha >= 0.0 && alpha < 1.0)) throw InputError("localDamping must be in [0, 1)");
+  m_num.localDamping = alpha;
+}
+
+void Simulation::refresh() {
+  rebuildNeighbours();
+  computeContacts();
+  m_stressPrev = m_stress;
+}
+
+void Simulation::step() {
+  auto t0 = Clock::now();
+  auto& sec = m_profile.seconds;
+  drift();
+  auto t1 = Clock::now();
+  sec[int(Stage::Drift)] += std::chrono::duration<double>(t1 - t0).count();
+  if (needsRebuild()) {
+    rebuildNeighbours();
+    ++m_profile.rebuilds;
+  }
+  auto t2 = Clock::now();
+  sec[int(Stage::Neighbours)] += std::chrono::duration<double>(t2 - t1).count();
+  computeContacts();
+  auto t3 = Clock::now();
+  sec[int(Stage::Contacts)] += std::chrono::duration<double>(t3 - t2).count();
+  kick();
+  m_time += m_dt;
+  ++m_step;
+  auto t4 = Clock::now();
+  sec[int(Stage::Kick)] += std::chrono::duration<double>(t4 - t3).count();
+  if (m_controller) m_cell.setVelocityGradient(m_controller->update(*this));
+  sec[int(Stage::Control)] += since(t4);
+  ++m_profile.steps;
+}
+
+// ---- 1. drift -----------------------------------------------------------------------------------
+void Simulation::drift() {
+  const double dt = m_dt, h = 0.5 * m_dt;
+  // Boundary work of the affine deformation over this step, trapezoidal in stress:
+  // dW = -V (sigma : L) dt with compression-positive sigma (see energy_ledger.hpp).
+  const Mat3& L = m_cell.velocityGradient();
+  const double V0 = m_cell.volume();
+  const Mat3 phi = m_cell.advance(dt);
+  const bool affine = !L.isZero(0.0);
+  if (affine && m_num.trackEnergy) {
+    const double Vm = 0.5 * (V0 + m_cell.volume());
+    m_energy.boundaryWork -= Vm * (m_stress.cwiseProduct(L)).sum() * dt;
+  }
+  const Mat3 Fref = m_cell.matrix() * m_refHinv;
+  const int n = static_cast<int>(m_p.size());
+  const double alpha = m_num.localDamping;
+  Vec3* x = m_p.pos.data();
+  Vec3* v = m_p.vel.data();
+  Vec3* w = m_p.angVel.data();
+  const Vec3* F = m_p.force.data();
+  const Vec3* T = m_p.torque.data();
+  const double* im = m_p.invMass.data();
+  const double* ii = m_p.invInertia.data();
+  const Vec3* x0 = m_refPos.data();
+  double maxd2 = 0.0;
+  double localWork = 0.0;
+#pragma omp parallel for num_threads(m_num.threads) schedule(static) reduction(max : maxd2)
+  for (int i = 0; i < n; ++i) {
+    Vec3 f = F[i], t = T[i];
+    if (alpha > 0.0) {
+      for (int k = 0; k < 3; ++k) {
+        f[k] -= alpha * std::abs(f[k]) * (v[i][k] > 0 ? 1.0 : (v[i][k] < 0 ? -1.0 : 0.0));
+        t[k] -= alpha * std::abs(t[k]) * (w[i][k] > 0 ? 1.0 : (w[i][k] < 0 ? -1.0 : 0.0));
+      }
+    }
+    v[i] += (h * im[i]) * f;
+    w[i] += (h * ii[i]) * t;
+    x[i] = affine ? Vec3(phi * x[i] + dt * v[i]) : Vec3(x[i] + dt * v[i]);
+    const Vec3 u = x[i] - Fref * x0[i];
+    maxd2 = std::max(maxd2, u.squaredNorm());
+  }
+  m_maxDisp2 = maxd2;
+  (void)localWork;
+}
+
+// ---- 2. neighbours ------------------------------------------------------------------------------
+bool Simulation::needsRebuild() const {
+  // A pair's gap can shrink by at most |u_i| + |u_j| (fluctuations since the rebuild) plus
+  // ||F - I|| * |l| (homogeneous cell strain since the rebuild, F = H H_ref^-1, |l| <= cut-off).
+  const Mat3 strain = m_cell.matrix() * m_refHinv - Mat3::Identity();
+  return 2.0 * std::sqrt(m_maxDisp2) + strain.norm() * m_cutoff > m_skin;
+}
+
+void Simulation::rebuildNeighbours() {
+  const std::size_t n = m_p.size();
+  // keys of the old pairs that carry history, with the image counters before wrapping
+  struct OldKey {
+    std::int32_t i, j;
+    Vec3i key;
+    std::size_t index;
+  };
+  std::vector<OldKey> old;
+  for (std::size_t p = 0; p < m_c.size(); ++p) {
+    if (m_c.history[p].tangentialForce.squaredNorm() == 0.0 && m_c.history[p].contactRadius == 0.0) continue;
+    const int i = m_c.first[p], j = m_c.second[p];
+    old.push_back({i, j, m_c.image[p].vec() - m_p.image[j] + m_p.image[i], p});
+  }
+  // wrap into the cell
+  for (std::size_t i = 0; i < n; ++i) m_p.image[i] += m_cell.wrap(m_p.pos[i]);
+  PairList L = findPairs(m_p, m_cell, m_skin, m_num.threads);
+  ContactStore next;
+  next.first = std::move(L.first);
+  next.second = std::move(L.second);
+  next.image = std::move(L.image);
+  next.history.assign(next.size(), ContactHistory{});
+  // carry history over by key: both lists are sorted by (i, j)
+  std::size_t q = 0;
+  for (std::size_t p = 0; p < next.size() && q < old.size(); ++p) {
+    const int i = next.first[p], j = next.second[p];
+    while (q < old.size() && (old[q].i < i || (old[q].i == i && old[q].j < j))) ++q;
+    for (std::size_t r = q; r < old.size() && old[r].i == i && old[r].j == j; ++r) {
+      const Vec3i key = next.image[p].vec() - m_p.image[j] + m_p.image[i];
+      if (key == old[r].key) {
+        next.history[p] = m_c.history[old[r].index];
+        break;
+      }
+    }
+  }
+  next.resizeResults();
+  next.buildAdjacency(n);
+  m_c = std::move(next);
+  m_refPos = m_p.pos;
+  m_refHinv = m_cell.inverse();
+  m_maxDisp2 = 0.0;
+  m_chunks.resize(std::max<std::size_t>(1, (std::max(m_c.size(), n) + kChunk - 1) / kChunk));
+}
+
+// ---- 3. contacts --------------------------------------------------------------------------------
+void Simulation::computeContacts() {
+  const bool damping = m_num.restitution < 1.0;
+  if (m_num.trackEnergy) {
+    damping ? contactPass<true, true>() : contactPass<true, false>();
+  } else {
+    damping ? contactPass<false, true>() : contactPass<false, false>();
+  }
+}
+
+template <bool kEnergy, bool kDamping>
+void Simulation::contactPass() {
+  const std::size_t np = m_c.size();
+  const std::size_t nchunks = (np + kChunk - 1) / kChunk;
+  const Mat3& H = m_cell.matrix();
+  const Mat3& L = m_cell.velocityGradient();
+  const double dt = m_dt;
+  const Vec3* x = m_p.pos.data();
+  const Vec3* v = m_p.vel.data();
+  const Vec3* w = m_p.angVel.data();
+  const double* rad = m_p.radius.data();
+  const double* im = m_p.invMass.data();
+  const std::uint16_t* mat = m_p.material.data();
+  ContactStore& c = m_c;
+  const PairTable& table = m_pairs;
+#pragma omp parallel for num_threads(m_num.threads) schedule(static)
+  for (std::size_t k = 0; k < nchunks; ++k) {
+    Chunk acc;
+    const std::size_t end = std::min(np, (k + 1) * kChunk);
+    for (std::size_t p = k * kChunk; p < end; ++p) {
+      const int i = c.first[p], j = c.second[p];
+      Vec3 d = x[j] - x[i];
+      const Image img = c.image[p];
+      if (!img.isZero()) d += H * img.vec().cast<double>();
+      const double R = rad[i] + rad[j];
+      const double dist2 = d.squaredNorm();
+      if (dist2 >= R * R) {
+        if (c.overlap[p] != 0.0 || c.history[p].contactRadius != 0.0) {
+          c.overlap[p] = 0.0;
+          c.normalForce[p] = 0.0;
+          c.force[p].setZero();
+          c.history[p] = ContactHistory{};
+        }
+        continue;
+      }
+      const double dist = std::sqrt(dist2);
+      const Vec3 n = d / dist;
+      const double delta = R - dist;
+      const double li = rad[i] - 0.5 * delta, lj = rad[j] - 0.5 * delta;
+      // relative velocity of j's contact point w.r.t. i's, including the mean field L·l, which carries the
+      // image shift velocity L·H·n for pairs across the boundary (verification ladder §2)
+      const Vec3 vrel = v[j] - v[i] + L * d - (lj * w[j] + li * w[i]).cross(n);
+      const double vn = vrel.dot(n);
+      const Vec3 vt = vrel - vn * n;
+      const PairParams& pp = table(mat[i], mat[j]);
+      const double Rstar = rad[i] * rad[j] / R;
+      const double mstar = 1.0 / (im[i] + im[j]);
+      const double a = std::sqrt(Rstar * delta);
+      const double fe = kernels::hertzForce(pp.effYoung, a, delta);
+      double fn = fe;
+      const double kn = kernels::hertzStiffness(pp.effYoung, a);
+      double dampPower = 0.0;
+      if constexpr (kDamping) {
+        const double cn = kernels::dampingCoefficient(pp.dampingRatio, kn, mstar);
+        fn = std::max(0.0, fe - cn * vn);  // no attraction
+        dampPower += (fe - fn) * vn;       // = cn vn^2 unless clamped
+      }
+      auto tr = kernels::mindlinNoSlip(n, vt, a, fn, pp.effShear, pp.friction, dt, c.history[p]);
+      Vec3 ft = tr.force;
+      if constexpr (kDamping) {
+        if (!tr.sliding) {
+          const Vec3 fd = -kernels::dampingCoefficient(pp.dampingRatio, tr.stiffness, mstar) * vt;
+          ft += fd;
+          dampPower -= fd.dot(vt);
+        }
+      }
+      const Vec3 f = fn * n + ft;
+      c.overlap[p] = delta;
+      c.distance[p] = dist;
+      c.normal[p] = n;
+      c.normalForce[p] = fn;
+      c.force[p] = f;
+      acc.stress += f * d.transpose();
+      acc.sumForce += f.norm();
+      ++acc.contacts;
+      acc.sliding += tr.sliding;
+      acc.maxOverlapRatio = std::max(acc.maxOverlapRatio, delta / std::min(rad[i], rad[j]));
+      acc.maxKOverM = std::max(acc.maxKOverM, std::max(kn, 3.5 * tr.stiffness) * (im[i] + im[j]));
+      if constexpr (kEnergy) {
+        acc.elasticN += kernels::hertzEnergy(fe, delta);
+        if (tr.stiffness > 0.0) acc.elasticT += tr.force.squaredNorm() / (2.0 * tr.stiffness);
+        acc.friction += tr.slipWork + tr.stiffnessWork;
+        acc.damping += dampPower * dt;
+      }
+    }
+    m_chunks[k] = acc;
+  }
+  // ordered reduction
+  Mat3 s = Mat3::Zero();
+  double eN = 0.0, eT = 0.0, fr = 0.0, dm = 0.0, sf = 0.0, mo = 0.0, mk = 0.0;
+  std::size_t nc = 0, ns = 0;
+  for (std::size_t k = 0; k < nchunks; ++k) {
+    const Chunk& a = m_chunks[k];
+    s += a.stress;
+    eN += a.elasticN;
+    eT += a.elasticT;
+    fr += a.friction;
+    dm += a.damping;
+    sf += a.sumForce;
+    nc += a.contacts;
+    ns += a.sliding;
+    mo = std::max(mo, a.maxOverlapRatio);
+    mk = std::max(mk, a.maxKOverM);
+  }
+  m_stressPrev = m_stress;
+  m_stress = s / m_cell.volume();
+  if constexpr (kEnergy) {
+    m_energy.elasticNormal = eN;
+    m_energy.elasticTangential = eT;
+    m_energy.frictionWork += fr;
+    m_energy.contactDampingWork += dm;
+  }
+  m_diag.contacts = nc;
+  m_diag.sliding = ns;
+  m_diag.meanContactForce = nc ? sf / static_cast<double>(nc) : 0.0;
+  m_diag.maxOverlapRatio = mo;
+  m_diag.maxStiffnessOverMass = mk;
+}
+
+// ---- 4. kick ------------------------------------------------------------------------------------
+void Simulation::kick() {
+  m_num.localDamping > 0.0 ? kickPass<true>() : kickPass<false>();
+}
+
+template <bool kLocalDamping>
+void Simulation::kickPass() {
+  const int n = static_cast<int>(m_p.size());
+  const std::size_t nchunks = (static_cast<std::size_t>(n) + kChunk - 1) / kChunk;
+  const double h = 0.5 * m_dt;
+  const double alpha = m_num.localDamping;
+  const ContactStore& c = m_c;
+  const double* rad = m_p.radius.data();
+  Vec3* F = m_p.force.data();
+  Vec3* T = m_p.torque.data();
+  Vec3* v = m_p.vel.data();
+  Vec3* w = m_p.angVel.data();
+  const double* im = m_p.invMass.data();
+  const double* ii = m_p.invInertia.data();
+#pragma omp parallel for num_threads(m_num.threads) schedule(static)
+  for (std::size_t k = 0; k < nchunks; ++k) {
+    double work = 0.0;
+    const int end = static_cast<int>(std::min<std::size_t>(n, (k + 1) * kChunk));
+    for (int i = static_cast<int>(k * kChunk); i < end; ++i) {
+      Vec3 f = Vec3::Zero(), t = Vec3::Zero();
+      for (int e = c.adjStart[i]; e < c.adjStart[i + 1]; ++e) {
+        const int entry = c.adjEntry[e];
+        const int p = entry >> 1;
+        if (c.overlap[p] <= 0.0) continue;
+        const Vec3& fp = c.force[p];
+        // torque = -(r_self - delta/2) n x f on both particles (contact point on the pair axis)
+        const double lever = rad[i] - 0.5 * c.overlap[p];
+        t -= lever * c.normal[p].cross(fp);
+        if (entry & 1) f += fp;
+        else f -= fp;
+      }
+      F[i] = f;
+      T[i] = t;
+      if constexpr (kLocalDamping) {
+        // Cundall non-viscous damping: each component of the force opposes the velocity by alpha |F|
+        for (int a = 0; a < 3; ++a) {
+          const double sv = v[i][a] > 0 ? 1.0 : (v[i][a] < 0 ? -1.0 : 0.0);
+          const double sw = w[i][a] > 0 ? 1.0 : (w[i][a] < 0 ? -1.0 : 0.0);
+          f[a] -= alpha * std::abs(f[a]) * sv;
+          t[a] -= alpha * std::abs(t[a]) * sw;
+          work += alpha * (std::abs(F[i][a] * v[i][a]) + std::abs(T[i][a] * w[i][a])) * m_dt;
+        }
+      }
+      v[i] += (h * im[i]) * f;
+      w[i] += (h * ii[i]) * t;
+    }
+    m_chunks[k].localDamping = work;
+  }
+  if constexpr (kLocalDamping) {
+    if (m_num.trackEnergy)
+      for (std::size_t k = 0; k < nchunks; ++k) m_energy.localDampingWork += m_chunks[k].localDamping;
+  }
+}
+
+// ---- measures -----------------------------------------------------------------------------------
+Mat3 Simulation::kineticStress() const {
+  Mat3 s = Mat3::Zero();
+  for (std::size_t i = 0; i < m_p.size(); ++i) s += (1.0 / m_p.invMass[i]) * m_p.vel[i] * m_p.vel[i].transpose();
+  return s / m_cell.volume();
+}
+
+const EnergyLedger& Simulation::energy() {
+  double k = 0.0;
+  for (std::size_t i = 0; i < m_p.size(); ++i)
+    k += 0.5 * (m_p.vel[i].squaredNorm() / m_p.invMass[i] + m_p.angVel[i].squaredNorm() / m_p.invInertia[i]);
+  m_energy.kinetic = k;
+  return m_energy;
+}
+
+double Simulation::unbalancedForceRatio() const {
+  if (m_diag.contacts == 0 || m_diag.meanContactForce <= 0.0) return 0.0;
+  double s = 0.0;
+  for (const Vec3& f : m_p.force) s += f.norm();
+  return s / static_cast<double>(m_p.size()) / m_diag.meanContactForce;
+}
+
+double Simulation::stiffnessTimeStep() const {
+  if (m_diag.maxStiffnessOverMass <= 0.0) return std::numeric_limits<double>::infinity();
+  return 2.0 / std::sqrt(m_diag.maxStiffnessOverMass);
+}
+
+}  // namespace fl

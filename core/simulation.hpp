@@ -1,0 +1,139 @@
+// The simulation: particles, periodic cell, contact store and the step pipeline.
+//
+// One step (velocity Verlet; Cundall & Strack 1979 explicit DEM), as a flat list of timed stages:
+//   1. drift      half kick v += dt/2 a, x = Phi x + dt v', cell H = Phi H (Phi = exp(L dt))
+//   2. neighbours rebuild the Verlet list when a displacement or the cell strain may exceed the skin
+//   3. contacts   Hertz–Mindlin forces for every pair, written into the contact store, with the
+//                 Love–Weber stress and (if tracked) energies summed in the same pass
+//   4. kick       forces gathered per particle in a fixed order, half kick v += dt/2 a
+//   5. control    the cell controller (if any) sets L for the next step
+// Deterministic: every reduction is over fixed-size chunks summed in chunk order, and forces are gathered
+// per particle from the CSR adjacency, so the bits do not depend on the thread count.
+// Stress sign: compression positive (soil mechanics), sigma = (1/V) sum_c f_c (x) l_c with f_c the force
+// on j and l_c the branch vector from i to j.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cell_controller.hpp"
+#include "contact_store.hpp"
+#include "energy_ledger.hpp"
+#include "material.hpp"
+#include "numerics.hpp"
+#include "particle_store.hpp"
+#include "periodic_cell.hpp"
+
+namespace fl {
+
+enum class Stage { Drift, Neighbours, Contacts, Kick, Control, Count };
+const char* stageName(Stage s);
+
+// Cumulative wall time per stage [s] and counts.
+struct StageProfile {
+  std::array<double, static_cast<int>(Stage::Count)> seconds{};
+  long steps = 0;
+  long rebuilds = 0;
+  double total() const;
+};
+
+// Per-step diagnostics gathered in the force pass (cheap).
+struct ContactDiagnostics {
+  double maxOverlapRatio = 0.0;   // max delta / min(r_i, r_j) [-]
+  double maxStiffnessOverMass = 0.0;  // max (k_n or 3.5 k_t) / m* [1/s^2]
+  double meanContactForce = 0.0;  // mean |f_c| over touching pairs [N]
+  std::size_t contacts = 0;       // touching pairs
+  std::size_t sliding = 0;        // pairs at the Coulomb limit
+};
+
+class Simulation {
+ public:
+  Simulation(ParticleStore particles, PeriodicCell cell, std::vector<Material> materials,
+             NumericsSettings numerics);
+  ~Simulation();
+  Simulation(Simulation&&) noexcept;
+  Simulation& operator=(Simulation&&) noexcept;
+
+  void step();
+  void run(long steps) {
+    for (long k = 0; k < steps; ++k) step();
+  }
+
+  // state
+  const ParticleStore& particles() const { return m_p; }
+  ParticleStore& mutableParticles() { return m_p; }  // callers must call refresh() after editing
+  const PeriodicCell& cell() const { return m_cell; }
+  const ContactStore& contacts() const { return m_c; }
+  const std::vector<Material>& materials() const { return m_materials; }
+  const NumericsSettings& numerics() const { return m_num; }
+  double time() const { return m_time; }     // [s]
+  long stepCount() const { return m_step; }
+  double timeStep() const { return m_dt; }   // [s]
+  double rayleighStep() const { return m_rayleigh; }  // [s], with density scaling
+  // 2 sqrt(m*/k) at the stiffest current contact [s]; infinity without contacts.
+  double stiffnessTimeStep() const;
+  double skin() const { return m_skin; }
+
+  // measures read from stored data
+  const Mat3& contactStress() const { return m_stress; }  // [Pa], compression positive
+  Mat3 kineticStress() const;                             // (1/V) sum m v' v' [Pa]
+  const EnergyLedger& energy();                           // refreshes the kinetic term
+  double unbalancedForceRatio() const;  // mean |F_i| / mean |f_c|
+  const ContactDiagnostics& diagnostics() const { return m_diag; }
+  const StageProfile& profile() const { return m_profile; }
+
+  // commands (apply between steps)
+  void setVelocityGradient(const Mat3& L) { m_cell.setVelocityGradient(L); }
+  void setController(std::shared_ptr<CellController> c) { m_controller = std::move(c); }
+  const std::shared_ptr<CellController>& controller() const { return m_controller; }
+  void setFriction(double mu);            // all material pairs
+  void setTimeStep(double dt);
+  void setLocalDamping(double alpha);
+  // Rebuild the neighbour list and recompute forces after the particles or cell were edited.
+  void refresh();
+  // Restore time/counters (checkpoint restart).
+  void setClock(double time, long step) {
+    m_time = time;
+    m_step = step;
+  }
+  EnergyLedger& mutableEnergy() { return m_energy; }
+
+ private:
+  void drift();
+  bool needsRebuild() const;
+  void rebuildNeighbours();
+  void computeContacts();
+  template <bool kEnergy, bool kDamping>
+  void contactPass();
+  void kick();
+  template <bool kLocalDamping>
+  void kickPass();
+
+  ParticleStore m_p;
+  PeriodicCell m_cell;
+  std::vector<Material> m_materials;
+  PairTable m_pairs;
+  NumericsSettings m_num;
+  ContactStore m_c;
+  std::shared_ptr<CellController> m_controller;
+
+  double m_dt = 0.0, m_time = 0.0, m_rayleigh = 0.0;
+  long m_step = 0;
+  double m_skin = 0.0, m_cutoff = 0.0;
+  // rebuild bookkeeping
+  std::vector<Vec3> m_refPos;  // positions at the last rebuild
+  Mat3 m_refHinv;              // H^-1 at the last rebuild
+  double m_maxDisp2 = 0.0;     // max |x - F x_ref|^2 after the last drift
+
+  Mat3 m_stress = Mat3::Zero();
+  Mat3 m_stressPrev = Mat3::Zero();
+  EnergyLedger m_energy;
+  ContactDiagnostics m_diag;
+  StageProfile m_profile;
+  struct Chunk;
+  std::vector<Chunk> m_chunks;
+};
+
+}  // namespace fl

@@ -1,0 +1,30 @@
+// Small builders shared by the core tests.
+#pragma once
+
+#include "core/simulation.hpp"
+
+namespace fl::test {
+
+// Two spheres in a large periodic box (so they meet only each other), moving at v1, v2.
+inline Simulation twoSpheres(double r1, double r2, const Vec3& x1, const Vec3& x2, const Vec3& v1,
+                             const Vec3& v2, const Material& m, NumericsSettings num, double box = 1.0) {
+  ParticleStore p;
+  p.add(x1, r1, m.density, 0);
+  p.add(x2, r2, m.density, 0);
+  p.vel[0] = v1;
+  p.vel[1] = v2;
+  return Simulation(std::move(p), PeriodicCell::box(box, box, box), {m}, num);
+}
+
+inline double effYoung(const Material& a, const Material& b) {
+  return 1.0 / ((1 - a.poissonRatio * a.poissonRatio) / a.youngModulus +
+                (1 - b.poissonRatio * b.poissonRatio) / b.youngModulus);
+}
+
+inline Vec3 momentum(const ParticleStore& p) {
+  Vec3 s = Vec3::Zero();
+  for (std::size_t i = 0; i < p.size(); ++i) s += p.vel[i] / p.invMass[i];
+  return s;
+}
+
+}  // namespace fl::test
