@@ -38,6 +38,15 @@ class PeriodicCell {
   Vec3 perpendicularWidths() const;
   // Wrap x into the cell; returns the integer vector k with x_new = x - H·k.
   Vec3i wrap(Vec3& x) const;
+  // checkpoint support: the log-strain accumulation state
+  const Mat3& logStrainReference() const { return m_Href; }
+  const Vec3& logStrain() const { return m_logStrain; }
+  void restore(const Mat3& H, const Mat3& L, const Mat3& Href, const Vec3& logStrain) {
+    setMatrix(H);
+    m_L = L;
+    m_Href = Href;
+    m_logStrain = logStrain;
+  }
   // Advance H by dt under the current L; returns the affine map Phi with H_new = Phi·H_old
   // (particles follow x_new = Phi·x_old + dt·v').
   Mat3 advance(double dt);

@@ -18,15 +18,6 @@ using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 }  // namespace
 
-// Partial sums of one fixed block of pairs (or particles), reduced in block order.
-struct Simulation::Chunk {
-  Mat3 stress = Mat3::Zero();  // sum f (x) l [N m]
-  double elasticN = 0.0, elasticT = 0.0, friction = 0.0, damping = 0.0, localDamping = 0.0;
-  double sumForce = 0.0, maxOverlapRatio = 0.0, maxKOverM = 0.0;
-  std::size_t contacts = 0, sliding = 0;
-  char pad[64] = {};  // keep neighbouring chunks on separate cache lines
-};
-
 const char* stageName(Stage s) {
   switch (s) {
     case Stage::Drift: return "drift";
@@ -303,6 +294,7 @@ void Simulation::contactPass() {
       c.normalForce[p] = fn;
       c.force[p] = f;
       acc.stress += f * d.transpose();
+      acc.stiffness += kn * n.cwiseProduct(d).cwiseAbs2();
       acc.sumForce += f.norm();
       ++acc.contacts;
       acc.sliding += tr.sliding;
@@ -320,10 +312,12 @@ void Simulation::contactPass() {
   // ordered reduction
   Mat3 s = Mat3::Zero();
   double eN = 0.0, eT = 0.0, fr = 0.0, dm = 0.0, sf = 0.0, mo = 0.0, mk = 0.0;
+  Vec3 stiff = Vec3::Zero();
   std::size_t nc = 0, ns = 0;
   for (std::size_t k = 0; k < nchunks; ++k) {
     const Chunk& a = m_chunks[k];
     s += a.stress;
+    stiff += a.stiffness;
     eN += a.elasticN;
     eT += a.elasticT;
     fr += a.friction;
@@ -347,6 +341,7 @@ void Simulation::contactPass() {
   m_diag.meanContactForce = nc ? sf / static_cast<double>(nc) : 0.0;
   m_diag.maxOverlapRatio = mo;
   m_diag.maxStiffnessOverMass = mk;
+  m_diag.axisStiffness = stiff / m_cell.volume();
 }
 
 // ---- 4. kick ------------------------------------------------------------------------------------

@@ -28,6 +28,9 @@
 
 namespace fl {
 
+class BinaryWriter;
+class BinaryReader;
+
 enum class Stage { Drift, Neighbours, Contacts, Kick, Control, Count };
 const char* stageName(Stage s);
 
@@ -46,6 +49,9 @@ struct ContactDiagnostics {
   double meanContactForce = 0.0;  // mean |f_c| over touching pairs [N]
   std::size_t contacts = 0;       // touching pairs
   std::size_t sliding = 0;        // pairs at the Coulomb limit
+  // Tangent stiffness of the packing for an affine strain along each axis, d sigma_kk / d eps_kk
+  // = (1/V) sum k_n (n_k l_k)^2 [Pa]; scales the servo gain.
+  Vec3 axisStiffness = Vec3::Zero();
 };
 
 class Simulation {
@@ -86,7 +92,12 @@ class Simulation {
 
   // commands (apply between steps)
   void setVelocityGradient(const Mat3& L) { m_cell.setVelocityGradient(L); }
-  void setController(std::shared_ptr<CellController> c) { m_controller = std::move(c); }
+  // Installs the controller and applies it at once (from the stored forces), so the next step already
+  // follows it; nullptr leaves the current L in place.
+  void setController(std::shared_ptr<CellController> c) {
+    m_controller = std::move(c);
+    if (m_controller) m_cell.setVelocityGradient(m_controller->update(*this));
+  }
   const std::shared_ptr<CellController>& controller() const { return m_controller; }
   void setFriction(double mu);            // all material pairs
   void setTimeStep(double dt);
@@ -100,11 +111,17 @@ class Simulation {
   }
   EnergyLedger& mutableEnergy() { return m_energy; }
 
+  // Full state for bit-exact restart (simulation_state.cpp): particles, cell, contact store with
+  // history, neighbour-list reference, stresses, energies, clock. The controller is not included.
+  void saveState(BinaryWriter& w) const;
+  static Simulation restoreState(BinaryReader& r);
+
  private:
   void drift();
   bool needsRebuild() const;
   void rebuildNeighbours();
   void computeContacts();
+  Simulation() = default;  // for restoreState
   template <bool kEnergy, bool kDamping>
   void contactPass();
   void kick();
@@ -132,7 +149,15 @@ class Simulation {
   EnergyLedger m_energy;
   ContactDiagnostics m_diag;
   StageProfile m_profile;
-  struct Chunk;
+  // Partial sums of one fixed block of pairs (or particles), reduced in block order.
+  struct Chunk {
+    Mat3 stress = Mat3::Zero();  // sum f (x) l [N m]
+    double elasticN = 0.0, elasticT = 0.0, friction = 0.0, damping = 0.0, localDamping = 0.0;
+    double sumForce = 0.0, maxOverlapRatio = 0.0, maxKOverM = 0.0;
+    Vec3 stiffness = Vec3::Zero();
+    std::size_t contacts = 0, sliding = 0;
+    char pad[64] = {};  // keep neighbouring chunks on separate cache lines
+  };
   std::vector<Chunk> m_chunks;
 };
 

@@ -1,0 +1,94 @@
+// Little binary serialisation for checkpoints: plain-old-data values and vectors appended to a byte
+// buffer, read back with bounds checks. Every read names the field, so a truncated or corrupted file
+// gives "checkpoint <file>: truncated at byte N reading <field>" instead of a crash.
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "errors.hpp"
+
+namespace fl {
+
+class BinaryWriter {
+ public:
+  template <class T>
+  void put(const T& v) {
+    static_assert(std::is_trivially_destructible_v<T> && std::is_standard_layout_v<T>);  // POD-like (Eigen fixed-size included)
+    const auto* b = reinterpret_cast<const char*>(&v);
+    m_buf.append(b, sizeof(T));
+  }
+  template <class T>
+  void putVector(const std::vector<T>& v) {
+    static_assert(std::is_trivially_destructible_v<T> && std::is_standard_layout_v<T>);  // POD-like (Eigen fixed-size included)
+    put<std::uint64_t>(v.size());
+    m_buf.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+  }
+  void putString(const std::string& s) {
+    put<std::uint64_t>(s.size());
+    m_buf.append(s);
+  }
+  const std::string& bytes() const { return m_buf; }
+
+ private:
+  std::string m_buf;
+};
+
+class BinaryReader {
+ public:
+  BinaryReader(const std::string& bytes, std::string source, std::size_t baseOffset = 0)
+      : m_buf(bytes), m_source(std::move(source)), m_base(baseOffset) {}
+
+  template <class T>
+  T get(const char* field) {
+    static_assert(std::is_trivially_destructible_v<T> && std::is_standard_layout_v<T>);  // POD-like (Eigen fixed-size included)
+    need(sizeof(T), field);
+    T v;
+    std::memcpy(static_cast<void*>(&v), m_buf.data() + m_pos, sizeof(T));
+    m_pos += sizeof(T);
+    return v;
+  }
+  template <class T>
+  std::vector<T> getVector(const char* field, std::uint64_t maxCount = 1ull << 31) {
+    const auto n = get<std::uint64_t>(field);
+    if (n > maxCount || n * sizeof(T) > m_buf.size() - m_pos)
+      fail(std::string("implausible length ") + std::to_string(n) + " for " + field);
+    std::vector<T> v(n);
+    if (n) std::memcpy(static_cast<void*>(v.data()), m_buf.data() + m_pos, n * sizeof(T));
+    m_pos += n * sizeof(T);
+    return v;
+  }
+  std::string getString(const char* field) {
+    auto v = getVector<char>(field, 1ull << 30);
+    return std::string(v.begin(), v.end());
+  }
+  std::size_t offset() const { return m_base + m_pos; }
+  bool atEnd() const { return m_pos == m_buf.size(); }
+  [[noreturn]] void fail(const std::string& what) const {
+    throw IoError(m_source + ": " + what + " (byte " + std::to_string(offset()) + ")");
+  }
+
+ private:
+  void need(std::size_t n, const char* field) const {
+    if (m_buf.size() - m_pos < n) fail(std::string("truncated while reading ") + field);
+  }
+  const std::string& m_buf;
+  std::string m_source;
+  std::size_t m_base;
+  std::size_t m_pos = 0;
+};
+
+// FNV-1a 64-bit checksum.
+inline std::uint64_t fnv1a64(const std::string& s) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : s) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+}  // namespace fl

@@ -1,0 +1,163 @@
+// Bit-exact save/restore of a Simulation (verification ladder §5: save at step N, reload, run k steps:
+// identical to an unbroken run). Everything the next step reads is saved, including the neighbour-list
+// reference positions and the previous stress used by the boundary-work integral.
+#include "binary_io.hpp"
+#include "simulation.hpp"
+
+namespace fl {
+
+namespace {
+constexpr std::uint32_t kStateVersion = 1;
+
+void putMat(BinaryWriter& w, const Mat3& m) {
+  for (int k = 0; k < 9; ++k) w.put(m.data()[k]);
+}
+Mat3 getMat(BinaryReader& r, const char* f) {
+  Mat3 m;
+  for (int k = 0; k < 9; ++k) m.data()[k] = r.get<double>(f);
+  return m;
+}
+}  // namespace
+
+void Simulation::saveState(BinaryWriter& w) const {
+  w.put(kStateVersion);
+  // materials and numerics
+  w.put<std::uint64_t>(m_materials.size());
+  for (const Material& m : m_materials) {
+    w.putString(m.name);
+    w.put(m.youngModulus);
+    w.put(m.poissonRatio);
+    w.put(m.density);
+    w.put(m.friction);
+  }
+  w.put(m_num);
+  // particles
+  w.putVector(m_p.pos);
+  w.putVector(m_p.vel);
+  w.putVector(m_p.angVel);
+  w.putVector(m_p.force);
+  w.putVector(m_p.torque);
+  w.putVector(m_p.radius);
+  w.putVector(m_p.invMass);
+  w.putVector(m_p.invInertia);
+  w.putVector(m_p.id);
+  w.putVector(m_p.material);
+  w.putVector(m_p.image);
+  // cell
+  putMat(w, m_cell.matrix());
+  putMat(w, m_cell.velocityGradient());
+  putMat(w, m_cell.logStrainReference());
+  w.put(m_cell.logStrain());
+  // contacts
+  w.putVector(m_c.first);
+  w.putVector(m_c.second);
+  w.putVector(m_c.image);
+  w.putVector(m_c.history);
+  w.putVector(m_c.normal);
+  w.putVector(m_c.overlap);
+  w.putVector(m_c.distance);
+  w.putVector(m_c.normalForce);
+  w.putVector(m_c.force);
+  // integrator and bookkeeping
+  w.put(m_dt);
+  w.put(m_time);
+  w.put(m_rayleigh);
+  w.put(m_step);
+  w.put(m_skin);
+  w.put(m_cutoff);
+  w.putVector(m_refPos);
+  putMat(w, m_refHinv);
+  w.put(m_maxDisp2);
+  putMat(w, m_stress);
+  putMat(w, m_stressPrev);
+  w.put(m_energy);
+  w.put(m_diag);
+}
+
+Simulation Simulation::restoreState(BinaryReader& r) {
+  const auto version = r.get<std::uint32_t>("state version");
+  if (version != kStateVersion)
+    r.fail("simulation state version " + std::to_string(version) + " is not supported (expected " +
+           std::to_string(kStateVersion) + ")");
+  Simulation s;
+  const auto nm = r.get<std::uint64_t>("material count");
+  if (nm == 0 || nm > 65535) r.fail("implausible material count");
+  for (std::uint64_t k = 0; k < nm; ++k) {
+    Material m;
+    m.name = r.getString("material name");
+    m.youngModulus = r.get<double>("material E");
+    m.poissonRatio = r.get<double>("material nu");
+    m.density = r.get<double>("material density");
+    m.friction = r.get<double>("material friction");
+    s.m_materials.push_back(m);
+  }
+  s.m_num = r.get<NumericsSettings>("numerics");
+  try {
+    s.m_num.validate();
+  } catch (const InputError& e) {
+    r.fail(std::string("invalid numerics: ") + e.what());
+  }
+  ParticleStore& p = s.m_p;
+  p.pos = r.getVector<Vec3>("positions");
+  p.vel = r.getVector<Vec3>("velocities");
+  p.angVel = r.getVector<Vec3>("angular velocities");
+  p.force = r.getVector<Vec3>("forces");
+  p.torque = r.getVector<Vec3>("torques");
+  p.radius = r.getVector<double>("radii");
+  p.invMass = r.getVector<double>("inverse masses");
+  p.invInertia = r.getVector<double>("inverse inertias");
+  p.id = r.getVector<std::int32_t>("ids");
+  p.material = r.getVector<std::uint16_t>("material indices");
+  p.image = r.getVector<Vec3i>("images");
+  const std::size_t n = p.pos.size();
+  if (n == 0 || p.vel.size() != n || p.angVel.size() != n || p.force.size() != n || p.torque.size() != n ||
+      p.radius.size() != n || p.invMass.size() != n || p.invInertia.size() != n || p.id.size() != n ||
+      p.material.size() != n || p.image.size() != n)
+    r.fail("particle arrays have inconsistent lengths");
+  for (std::size_t i = 0; i < n; ++i)
+    if (p.material[i] >= nm || !(p.radius[i] > 0.0)) r.fail("invalid particle " + std::to_string(i));
+  const Mat3 H = getMat(r, "cell matrix"), L = getMat(r, "velocity gradient"), Href = getMat(r, "cell reference");
+  const Vec3 logStrain = r.get<Vec3>("log strain");
+  if (!(H.determinant() > 0.0) || !(Href.determinant() > 0.0)) r.fail("cell matrix is not invertible");
+  s.m_cell.restore(H, L, Href, logStrain);
+  ContactStore& c = s.m_c;
+  c.first = r.getVector<std::int32_t>("pair first");
+  c.second = r.getVector<std::int32_t>("pair second");
+  c.image = r.getVector<Image>("pair image");
+  c.history = r.getVector<ContactHistory>("contact history");
+  c.normal = r.getVector<Vec3>("contact normals");
+  c.overlap = r.getVector<double>("contact overlaps");
+  c.distance = r.getVector<double>("contact distances");
+  c.normalForce = r.getVector<double>("contact normal forces");
+  c.force = r.getVector<Vec3>("contact forces");
+  const std::size_t np = c.first.size();
+  if (c.second.size() != np || c.image.size() != np || c.history.size() != np || c.normal.size() != np ||
+      c.overlap.size() != np || c.distance.size() != np || c.normalForce.size() != np || c.force.size() != np)
+    r.fail("contact arrays have inconsistent lengths");
+  for (std::size_t k = 0; k < np; ++k)
+    if (c.first[k] < 0 || c.second[k] < 0 || static_cast<std::size_t>(c.first[k]) >= n ||
+        static_cast<std::size_t>(c.second[k]) >= n)
+      r.fail("contact " + std::to_string(k) + " names a particle that does not exist");
+  c.buildAdjacency(n);
+  s.m_dt = r.get<double>("time step");
+  s.m_time = r.get<double>("time");
+  s.m_rayleigh = r.get<double>("rayleigh step");
+  s.m_step = r.get<long>("step");
+  s.m_skin = r.get<double>("skin");
+  s.m_cutoff = r.get<double>("cutoff");
+  s.m_refPos = r.getVector<Vec3>("reference positions");
+  if (s.m_refPos.size() != n) r.fail("reference positions have the wrong length");
+  s.m_refHinv = getMat(r, "reference inverse cell");
+  s.m_maxDisp2 = r.get<double>("max displacement");
+  s.m_stress = getMat(r, "stress");
+  s.m_stressPrev = getMat(r, "previous stress");
+  s.m_energy = r.get<EnergyLedger>("energy ledger");
+  s.m_diag = r.get<ContactDiagnostics>("diagnostics");
+  if (!(s.m_dt > 0.0)) r.fail("time step must be > 0");
+  // friction may have been changed during the run: the materials carry the current value
+  s.m_pairs = PairTable(s.m_materials, s.m_num.restitution);
+  s.m_chunks.resize(std::max<std::size_t>(1, (std::max(np, n) + 1023) / 1024));
+  return s;
+}
+
+}  // namespace fl
