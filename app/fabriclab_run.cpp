@@ -1,14 +1,4 @@
-// Headless command (core only; no Qt, no VTK).
-#include <cstdio>
+// fabriclab-run: the core-only headless command (no Qt, no VTK), for cluster nodes and batch studies.
+#include "headless.hpp"
 
-#include "core/gas_generator.hpp"
-#include "core/simulation.hpp"
-
-int main() {
-  fl::GasSpec g;
-  g.count = 1000;
-  fl::Packing pk = fl::generateGas(g);
-  fl::Simulation sim(std::move(pk.particles), pk.cell, {fl::Material::paperGlass()}, fl::NumericsSettings{});
-  sim.run(100);
-  std::printf("steps %ld\n", sim.stepCount());
-}
+int main(int argc, char** argv) { return fl::app::runHeadless(argc, argv); }

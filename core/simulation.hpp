@@ -115,6 +115,10 @@ class Simulation {
   // history, neighbour-list reference, stresses, energies, clock. The controller is not included.
   void saveState(BinaryWriter& w) const;
   static Simulation restoreState(BinaryReader& r);
+  // Applies another scene's material and numerics to a restored specimen (branching one specimen into
+  // several histories): masses from the new density and density scale, pair table, time step, threads.
+  // The contact state and the skin are kept.
+  void reconfigure(const Material& material, const NumericsSettings& numerics);
 
  private:
   void drift();

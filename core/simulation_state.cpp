@@ -160,4 +160,22 @@ Simulation Simulation::restoreState(BinaryReader& r) {
   return s;
 }
 
+void Simulation::reconfigure(const Material& material, const NumericsSettings& numerics) {
+  numerics.validate();
+  for (std::uint16_t m : m_p.material)
+    if (m != 0) throw InputError("reconfigure: the specimen uses several materials; a scene defines one");
+  m_materials = {material};
+  m_num = numerics;
+  m_num.skin = m_skin;
+  for (std::size_t i = 0; i < m_p.size(); ++i) {
+    const double r = m_p.radius[i];
+    const double m = material.density * numerics.densityScale * 4.0 / 3.0 * kPi * r * r * r;
+    m_p.invMass[i] = 1.0 / m;
+    m_p.invInertia[i] = 1.0 / (0.4 * m * r * r);
+  }
+  m_pairs = PairTable(m_materials, m_num.restitution);
+  m_rayleigh = rayleighTimeStep(m_p, m_materials, m_num.densityScale);
+  m_dt = m_num.timeStep > 0.0 ? m_num.timeStep : m_num.timeStepFactor * m_rayleigh;
+}
+
 }  // namespace fl
