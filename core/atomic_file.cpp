@@ -24,8 +24,8 @@ namespace {
 [[noreturn]] void abandon(int fd, const std::string& tmp, const std::string& path, const char* step, int err) {
   if (fd >= 0) ::close(fd);
   ::unlink(tmp.c_str());
-  throw IoError("cannot write '" + path + "': " + step + " of temporary file '" + tmp + "' failed: " +
-                std::strerror(err));
+  throw IoError("cannot write '" + path + "': " + step + " of temporary file '" + tmp +
+                "' failed: " + std::strerror(err));
 }
 
 }  // namespace
@@ -50,8 +50,8 @@ void writeFileAtomically(const std::string& path, const std::string& contents) {
   if (::rename(tmp.c_str(), path.c_str()) != 0) abandon(-1, tmp, path, "rename", errno);
 
   // The new contents are in place; make the rename itself survive a power loss.
-  std::string dir = std::filesystem::path(path).parent_path().string();
-  if (dir.empty()) dir = ".";
+  const std::string parent = std::filesystem::path(path).parent_path().string();
+  const std::string dir = parent.empty() ? std::string(".") : parent;
   const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (dfd < 0) throwIo("wrote '" + path + "' but cannot open its directory", dir, errno);
   // Some file systems cannot fsync a directory (EINVAL); the rename is then as durable as they allow.

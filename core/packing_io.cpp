@@ -18,7 +18,7 @@ namespace fl {
 
 namespace {
 
-constexpr std::size_t kMaxLine = 4096;              // bytes per line; longer is garbage, not a packing
+constexpr std::size_t kMaxLine = 4096;             // bytes per line; longer is garbage, not a packing
 constexpr std::size_t kMaxParticles = 50'000'000;  // beyond what one node simulates; guards allocation
 
 // A value quoted in a message: short and printable, whatever bytes the file holds.
@@ -108,8 +108,7 @@ class LineReader {
         m_bufLen = std::fread(m_buf.data(), 1, m_buf.size(), m_file);
         m_bufPos = 0;
         if (m_bufLen == 0) {
-          if (std::ferror(m_file))
-            throw IoError("cannot read '" + m_path + "': " + std::strerror(errno));
+          if (std::ferror(m_file)) throw IoError("cannot read '" + m_path + "': " + std::strerror(errno));
           if (!any) return false;
           m_unterminated = true;
           break;
@@ -152,8 +151,7 @@ class LineReader {
     failAt(m_lineNo, m_consumed, what + " [at end of file]");
   }
   [[noreturn]] void failAt(long line, std::size_t offset, const std::string& what) const {
-    throw InputError(m_path + ":" + std::to_string(line) + ": " + what + " (byte " + std::to_string(offset) +
-                     ")");
+    throw InputError(m_path + ":" + std::to_string(line) + ": " + what + " (byte " + std::to_string(offset) + ")");
   }
   // "field 'x' must be a finite number, got 'nan'"
   double finite(std::string_view tok, std::string_view field) const {
@@ -202,7 +200,8 @@ Vec3 wrapChecked(const LineReader& in, std::string_view at, const PeriodicCell& 
   const Vec3 s = cell.reduced(x);
   for (int k = 0; k < 3; ++k)
     if (!(s[k] >= -1.0 && s[k] < 2.0))
-      in.fail(at, std::string("field '") + kAxis[k] + "': particle lies more than one cell length outside the cell " +
+      in.fail(at, std::string("field '") + kAxis[k] +
+                      "': particle lies more than one cell length outside the cell " +
                       "(reduced coordinate along cell vector " + std::to_string(k + 1) + " is " + g17(s[k]) +
                       ", expected in [-1, 2)); wrong units or wrong cell?");
   cell.wrap(x);
@@ -240,8 +239,8 @@ Packing readCsv(const std::string& path, double density, int material, const Per
         Mat3 H;
         for (int k = 0; k < 9; ++k) H(k / 3, k % 3) = in.finite(tok[k + 1], kH[k]);
         if (!(H.determinant() > 0.0))
-          in.fail(tok[0], "field 'cell': the cell matrix must have a positive determinant, got " +
-                              g17(H.determinant()));
+          in.fail(tok[0],
+                  "field 'cell': the cell matrix must have a positive determinant, got " + g17(H.determinant()));
         fileCell = H;
       }
       continue;  // any other comment
@@ -261,8 +260,9 @@ Packing readCsv(const std::string& path, double density, int material, const Per
   } else if (fileCell) {
     cell = PeriodicCell(*fileCell);
   } else {
-    in.fail({}, "field 'cell': no '# cell H00 ... H22' line before the header row; add one or pass the "
-                "cell explicitly (readPackingCsv overload with a PeriodicCell)");
+    in.fail({},
+            "field 'cell': no '# cell H00 ... H22' line before the header row; add one or pass the "
+            "cell explicitly (readPackingCsv overload with a PeriodicCell)");
   }
 
   static constexpr std::array<const char*, 4> kField{"x", "y", "z", "r"};
@@ -373,7 +373,9 @@ Packing readLammpsData(const std::string& path, int material) {
                        ": expected 'N atoms', 'N atom types', 'lo hi xlo xhi' (or y, z) or 'xy xz yz'");
       if (box[axis]) in.fail(tok[2], "field '" + std::string(kLo[axis]) + " " + kHi[axis] + "': declared twice");
       const double lo = in.finite(tok[0], kLo[axis]), hi = in.finite(tok[1], kHi[axis]);
-      if (!(hi > lo)) in.fail(tok[1], "field '" + std::string(kHi[axis]) + "' must exceed '" + kLo[axis] + "', got " + quoted(tok[1]));
+      if (!(hi > lo))
+        in.fail(tok[1],
+                "field '" + std::string(kHi[axis]) + "' must exceed '" + kLo[axis] + "', got " + quoted(tok[1]));
       box[axis] = std::make_pair(lo, hi);
     }
   }
@@ -381,7 +383,8 @@ Packing readLammpsData(const std::string& path, int material) {
   if (atoms < 0) in.fail(section, "field 'atoms': no 'N atoms' header line before the first section");
   for (int k = 0; k < 3; ++k)
     if (!box[k])
-      in.fail(section, "field '" + std::string(kLo[k]) + " " + kHi[k] + "': no box header line before the first section");
+      in.fail(section,
+              "field '" + std::string(kLo[k]) + " " + kHi[k] + "': no box header line before the first section");
   const Vec3 lo(box[0]->first, box[1]->first, box[2]->first);
   const Vec3 len(box[0]->second - lo.x(), box[1]->second - lo.y(), box[2]->second - lo.z());
   if (!(len.prod() > 0.0 && std::isfinite(len.prod())))
@@ -422,8 +425,9 @@ Packing readLammpsData(const std::string& path, int material) {
       const auto tok = splitWhitespace(t);
       const bool imageFlags = isAtoms && tok.size() == 10;
       if (tok.size() != expectedFields && !imageFlags) {
-        const std::string what = isAtoms ? "7 fields 'atom-ID atom-type diameter density x y z' (or 10 with image flags)"
-                                         : "7 fields 'atom-ID vx vy vz wx wy wz'";
+        const std::string what =
+            isAtoms ? "7 fields 'atom-ID atom-type diameter density x y z' (or 10 with image flags)"
+                    : "7 fields 'atom-ID vx vy vz wx wy wz'";
         if (tok.size() < expectedFields)
           in.fail(t, "field '" + std::string(isAtoms ? kAtomField[tok.size()] : kVelField[tok.size()]) +
                          "' is missing: expected " + what + ", got " + std::to_string(tok.size()));
@@ -441,13 +445,14 @@ Packing readLammpsData(const std::string& path, int material) {
         keys.push_back({id, out.particles.size(), in.lineNumber(), in.lineOffset()});
         out.particles.add(wrapChecked(in, tok[4], cell, x - lo), 0.5 * d, rho, material);
       } else {
-        const auto it = std::lower_bound(keys.begin(), keys.end(), id,
-                                         [](const AtomKey& a, long long v) { return a.id < v; });
+        const auto it =
+            std::lower_bound(keys.begin(), keys.end(), id, [](const AtomKey& a, long long v) { return a.id < v; });
         if (it == keys.end() || it->id != id)
           in.fail(tok[0], "field 'atom-ID': no atom with ID " + quoted(tok[0]) + " in the 'Atoms' section");
         if (it->line < 0) in.fail(tok[0], "field 'atom-ID': velocity of atom " + quoted(tok[0]) + " given twice");
         it->line = -1;  // mark as seen
-        out.particles.vel[it->index] = Vec3(in.finite(tok[1], "vx"), in.finite(tok[2], "vy"), in.finite(tok[3], "vz"));
+        out.particles.vel[it->index] =
+            Vec3(in.finite(tok[1], "vx"), in.finite(tok[2], "vy"), in.finite(tok[3], "vz"));
         out.particles.angVel[it->index] =
             Vec3(in.finite(tok[4], "wx"), in.finite(tok[5], "wy"), in.finite(tok[6], "wz"));
       }
@@ -458,8 +463,9 @@ Packing readLammpsData(const std::string& path, int material) {
       });
       for (std::size_t k = 1; k < keys.size(); ++k)
         if (keys[k].id == keys[k - 1].id)
-          in.failAt(keys[k].line, keys[k].offset, "field 'atom-ID': ID " + std::to_string(keys[k].id) +
-                                         " already used on line " + std::to_string(keys[k - 1].line));
+          in.failAt(keys[k].line, keys[k].offset,
+                    "field 'atom-ID': ID " + std::to_string(keys[k].id) + " already used on line " +
+                        std::to_string(keys[k - 1].line));
     }
     haveAtoms = haveAtoms || isAtoms;
     haveVelocities = haveVelocities || isVelocities;
@@ -486,7 +492,8 @@ void writeLammpsData(const std::string& path, const ParticleStore& particles, co
                      const std::vector<Material>& materials) {
   const Mat3& H = cell.matrix();
   if (!(H - Mat3(H.diagonal().asDiagonal())).isZero(0.0))
-    throw InputError("writeLammpsData '" + path + "': only orthorhombic cells are supported, the cell matrix has "
+    throw InputError("writeLammpsData '" + path +
+                     "': only orthorhombic cells are supported, the cell matrix has "
                      "off-diagonal terms");
   if (materials.empty()) throw InputError("writeLammpsData '" + path + "': no materials given");
   std::string s = "LAMMPS data file written by FabricLab (atom_style sphere, units si)\n\n";
@@ -503,8 +510,8 @@ void writeLammpsData(const std::string& path, const ParticleStore& particles, co
     wrapped[i] = particles.pos[i];
     cell.wrap(wrapped[i]);
     const Vec3& x = wrapped[i];
-    std::snprintf(row, sizeof row, "%zu %zu %.17g %.17g %.17g %.17g %.17g\n", i + 1, m + 1, 2.0 * particles.radius[i],
-                  materials[m].density, x.x(), x.y(), x.z());
+    std::snprintf(row, sizeof row, "%zu %zu %.17g %.17g %.17g %.17g %.17g\n", i + 1, m + 1,
+                  2.0 * particles.radius[i], materials[m].density, x.x(), x.y(), x.z());
     s += row;
   }
   s += "\nVelocities\n\n";

@@ -1,5 +1,6 @@
 #include "vtk_xml_writer.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 
@@ -186,9 +187,10 @@ void writeCellVtu(const std::string& path, const PeriodicCell& cell) {
 void PvdCollection::add(double time, const std::string& relativeFile) {
   if (!std::isfinite(time))
     throw InputError("PvdCollection '" + m_path + "': time must be finite for '" + relativeFile + "'");
+  // Shortest text that reads back as the same double: close output times stay distinct.
   char t[32];
-  std::snprintf(t, sizeof t, "%.17g", time);  // full precision: close output times must stay distinct
-  m_entries.push_back("    <DataSet timestep=\"" + std::string(t) + "\" group=\"\" part=\"0\" file=\"" +
+  const auto end = std::to_chars(t, t + sizeof t, time).ptr;
+  m_entries.push_back("    <DataSet timestep=\"" + std::string(t, end) + "\" group=\"\" part=\"0\" file=\"" +
                       xmlEscape(relativeFile) + "\"/>\n");
   std::string s =
       "<?xml version=\"1.0\"?>\n"
