@@ -14,6 +14,7 @@ void PeriodicCell::setMatrix(const Mat3& H) {
   m_Hinv = H.inverse();
   m_Href = H;
   m_logStrain.setZero();
+  m_logComp.setZero();
 }
 
 Vec3 PeriodicCell::perpendicularWidths() const {
@@ -34,7 +35,12 @@ Mat3 PeriodicCell::advance(double dt) {
                         m_L(2, 0) == 0.0 && m_L(2, 1) == 0.0;
   if (diagonal) {
     const Vec3 old = m_logStrain;
-    m_logStrain += m_L.diagonal() * dt;
+    for (int a = 0; a < 3; ++a) {  // Kahan summation
+      const double y = m_L(a, a) * dt - m_logComp[a];
+      const double t = m_logStrain[a] + y;
+      m_logComp[a] = (t - m_logStrain[a]) - y;
+      m_logStrain[a] = t;
+    }
     Mat3 phi = Mat3::Zero();
     Mat3 H = m_Href;
     for (int a = 0; a < 3; ++a) {

@@ -8,7 +8,8 @@
 // perpendicular width of the cell to exceed the interaction cut-off (checked, CellTooSmallError).
 // Time update: while L stays diagonal the logarithmic strain e_k += L_kk dt is accumulated and
 // H = diag(exp(e)) H_ref is formed from it, so an isochoric L (trace 0) keeps det H to round-off over
-// any number of steps (multiplying by a fixed exp(L dt) would drift by its rounding every step). A
+// any number of steps (multiplying by a fixed exp(L dt) would drift by its rounding every step; the sum
+// itself is Kahan-compensated for the same reason). A
 // general L uses a second-order Taylor step and resets the reference.
 #pragma once
 
@@ -41,11 +42,13 @@ class PeriodicCell {
   // checkpoint support: the log-strain accumulation state
   const Mat3& logStrainReference() const { return m_Href; }
   const Vec3& logStrain() const { return m_logStrain; }
-  void restore(const Mat3& H, const Mat3& L, const Mat3& Href, const Vec3& logStrain) {
+  const Vec3& logStrainCompensation() const { return m_logComp; }
+  void restore(const Mat3& H, const Mat3& L, const Mat3& Href, const Vec3& logStrain, const Vec3& comp) {
     setMatrix(H);
     m_L = L;
     m_Href = Href;
     m_logStrain = logStrain;
+    m_logComp = comp;
   }
   // Advance H by dt under the current L; returns the affine map Phi with H_new = Phi·H_old
   // (particles follow x_new = Phi·x_old + dt·v').
@@ -57,6 +60,8 @@ class PeriodicCell {
   Mat3 m_L = Mat3::Zero();
   Mat3 m_Href;                    // H when the log-strain accumulation started
   Vec3 m_logStrain = Vec3::Zero();  // accumulated L_kk dt since m_Href [-]
+  Vec3 m_logComp = Vec3::Zero();    // Kahan compensation of that sum: small constant increments added to
+                                    // a large total would otherwise round the same way every step
 };
 
 }  // namespace fl

@@ -7,7 +7,7 @@
 namespace fl {
 
 namespace {
-constexpr std::uint32_t kStateVersion = 1;
+constexpr std::uint32_t kStateVersion = 2;
 
 void putMat(BinaryWriter& w, const Mat3& m) {
   for (int k = 0; k < 9; ++k) w.put(m.data()[k]);
@@ -48,6 +48,7 @@ void Simulation::saveState(BinaryWriter& w) const {
   putMat(w, m_cell.velocityGradient());
   putMat(w, m_cell.logStrainReference());
   w.put(m_cell.logStrain());
+  w.put(m_cell.logStrainCompensation());
   // contacts
   w.putVector(m_c.first);
   w.putVector(m_c.second);
@@ -118,8 +119,9 @@ Simulation Simulation::restoreState(BinaryReader& r) {
     if (p.material[i] >= nm || !(p.radius[i] > 0.0)) r.fail("invalid particle " + std::to_string(i));
   const Mat3 H = getMat(r, "cell matrix"), L = getMat(r, "velocity gradient"), Href = getMat(r, "cell reference");
   const Vec3 logStrain = r.get<Vec3>("log strain");
+  const Vec3 logComp = r.get<Vec3>("log strain compensation");
   if (!(H.determinant() > 0.0) || !(Href.determinant() > 0.0)) r.fail("cell matrix is not invertible");
-  s.m_cell.restore(H, L, Href, logStrain);
+  s.m_cell.restore(H, L, Href, logStrain, logComp);
   ContactStore& c = s.m_c;
   c.first = r.getVector<std::int32_t>("pair first");
   c.second = r.getVector<std::int32_t>("pair second");

@@ -28,7 +28,7 @@ Simulation movingGas(double mu, double restitution, double solidFraction, int co
   NumericsSettings num;
   num.timeStepFactor = 0.2;
   num.restitution = restitution;
-  num.threads = 2;
+  num.threads = 1;
   return Simulation(std::move(pk.particles), pk.cell, {m}, num);
 }
 }  // namespace

@@ -28,7 +28,7 @@ TEST(Restart, SaveReloadRunIsBitIdenticalToAnUnbrokenRun) {
   NumericsSettings num;
   num.restitution = 0.6;
   num.localDamping = 0.05;
-  num.threads = 2;
+  num.threads = 1;
   Simulation a(std::move(pk.particles), pk.cell, {Material::paperGlass()}, num);
   Mat3 L = Mat3::Zero();
   L.diagonal() = Vec3(-300, -300, -400);

@@ -13,7 +13,7 @@
 using namespace fl;
 
 namespace {
-Simulation smallGas(int threads = 2) {
+Simulation smallGas(int threads = 1) {
   GasSpec g;
   g.count = 400;
   g.solidFraction = 0.35;

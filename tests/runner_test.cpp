@@ -1,0 +1,223 @@
+// The runner on reduced scenes: every stage type completes with its criterion met, K0 keeps eps_r = 0,
+// undrained cycles keep the volume, drained cycles hold the lateral stress, load reversals make no
+// stress spike, the failure cycle is reported, and a checkpoint restart is bit-identical.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include "core/errors.hpp"
+#include "core/measurements.hpp"
+#include "core/runner.hpp"
+
+using namespace fl;
+using nlohmann::json;
+
+namespace {
+// A small, fast specimen: 300 spheres, density scaling for a large step (controller tests, not physics).
+json smallScene() {
+  return json::parse(R"({
+    "name": "runner test",
+    "specimen": {"count": 300, "solid_fraction": 0.3, "seed": 2},
+    "numerics": {"time_step_factor": 0.3, "local_damping": 0.1, "density_scale": 100, "threads": 1},
+    "servo": {"max_strain_rate": 20, "max_inertial_number": 0.02, "unbalanced_tolerance": 0.01},
+    "output": {"sample_interval": 500},
+    "stages": [
+      {"type": "isotropic_compression", "pressure": 50000, "friction": 0.1, "friction_after": 0.235}
+    ]
+  })");
+}
+
+Runner run(const json& j) {
+  Runner r(parseScene(j, "test.json"));
+  while (r.advance(5000)) {
+  }
+  return r;
+}
+}  // namespace
+
+TEST(RunnerStages, IsotropicCompressionReachesTargetAndSetsFrictionAfter) {
+  Runner r = run(smallScene());
+  ASSERT_EQ(r.summaries().size(), 1u);
+  const Sample& end = r.summaries()[0].end;
+  EXPECT_NEAR(end.p / 50000, 1.0, 2e-3);
+  EXPECT_LT(end.unbalanced, 0.01);
+  EXPECT_EQ(r.simulation().materials()[0].friction, 0.235);
+  EXPECT_GT(end.Z, 3.5);
+  EXPECT_GT(end.voidRatio, 0.4);
+  EXPECT_LT(end.voidRatio, 0.9);
+}
+
+TEST(RunnerStages, K0LoadingUnloadingAndOcr) {
+  json j = smallScene();
+  j["stages"].push_back({{"type", "k0"}, {"axial_stress", 200000}});
+  j["stages"].push_back({{"type", "k0"}, {"until_isotropic", true}});
+  Runner r = run(j);
+  ASSERT_EQ(r.summaries().size(), 3u);
+  const StageSummary& load = r.summaries()[1];
+  const StageSummary& unload = r.summaries()[2];
+  EXPECT_NEAR(load.end.stress.z() / 200000, 1.0, 2e-3);
+  EXPECT_EQ(load.end.epsR, 0.0);  // lateral strain exactly zero
+  EXPECT_GT(load.K0, 0.2);
+  EXPECT_LT(load.K0, 0.9);
+  EXPECT_EQ(unload.end.epsR, 0.0);
+  EXPECT_NEAR(unload.end.q / unload.end.p, 0.0, 2e-3);  // isotropic at the end
+  EXPECT_NEAR(unload.K0, 1.0, 3e-3);
+  EXPECT_GT(unload.ocr, 1.5);  // over-consolidated: sigma'_v,max / sigma'_v
+}
+
+TEST(RunnerStages, DrainedAndUndrainedTriaxial) {
+  for (const char* drainage : {"drained", "undrained"}) {
+    json j = smallScene();
+    j["stages"].push_back({{"type", "triaxial"}, {"drainage", drainage}, {"axial_strain", 0.01}, {"strain_rate", 0.5}});
+    Runner r = run(j);
+    const StageSummary& t = r.summaries().back();
+    EXPECT_GE(t.end.epsA, 0.01);
+    EXPECT_LT(t.end.epsA, 0.0101);
+    EXPECT_GT(t.end.q, 1000) << drainage;
+    if (std::string(drainage) == "undrained") {  // constant volume
+      EXPECT_NEAR(t.end.epsV, 0.0, 1e-13);
+      // du = sigma'_3,0 - sigma'_3 (constant cell pressure)
+      EXPECT_NEAR(t.end.du, r.summaries()[0].end.stress.x() * 0.5 + r.summaries()[0].end.stress.y() * 0.5 -
+                                0.5 * (t.end.stress.x() + t.end.stress.y()),
+                  1e-6 * t.end.p);
+    } else {  // lateral stresses held by the servo
+      const Vec3& s0 = r.summaries()[0].end.stress;
+      EXPECT_NEAR((t.end.stress.x() + t.end.stress.y()) / (s0.x() + s0.y()), 1.0, 0.02);
+    }
+  }
+}
+
+TEST(RunnerStages, CyclicUndrainedKeepsVolumeCountsCyclesAndHasNoReversalSpikes) {
+  json j = smallScene();
+  j["stages"].push_back({{"type", "cyclic"}, {"drainage", "undrained"}, {"amplitude", 2.3e-4}, {"cycles", 3},
+                         {"strain_rate", 0.5}, {"samples_per_cycle", 40}});
+  Runner r = run(j);
+  ASSERT_EQ(r.cycles().size(), 3u);
+  for (const CycleRecord& c : r.cycles()) {
+    EXPECT_GT(c.Gsec, 20e6);
+    EXPECT_LT(c.Gsec, 2e9);
+    EXPECT_NEAR(c.gammaMax, 1.5 * 2.3e-4, 0.05 * 2.3e-4);  // gamma = 1.5 eps_a at constant volume
+    EXPECT_NEAR(c.end.epsV, 0.0, 1e-13);
+  }
+  // samples evenly spaced in strain, and q changes smoothly through reversals: no jump between
+  // consecutive samples larger than a quarter of the cycle's q range
+  double qRange = 0, maxJump = 0;
+  const auto& s = r.samples();
+  int cyclic = 0;
+  for (std::size_t k = 1; k < s.size(); ++k) {
+    if (s[k].cycle == 0 || s[k - 1].cycle == 0) continue;
+    ++cyclic;
+    qRange = std::max(qRange, std::abs(s[k].q));
+    maxJump = std::max(maxJump, std::abs(s[k].q - s[k - 1].q));
+  }
+  EXPECT_GT(cyclic, 3 * 40 - 5);
+  EXPECT_LT(maxJump, 0.25 * 2 * qRange);
+}
+
+TEST(RunnerStages, CyclicDrainedHoldsLateralStress) {
+  json j = smallScene();
+  j["stages"].push_back({{"type", "cyclic"}, {"drainage", "drained"}, {"amplitude", 2.3e-4}, {"cycles", 2},
+                         {"strain_rate", 0.5}});
+  Runner r = run(j);
+  ASSERT_EQ(r.cycles().size(), 2u);
+  const double lat0 = r.summaries()[0].end.stress.x();
+  for (const Sample& s : r.samples())
+    if (s.cycle > 0) {
+      EXPECT_NEAR(s.stress.x() / lat0, 1.0, 0.05);
+    }
+}
+
+TEST(RunnerStages, MaxStepsGivesAClearError) {
+  json j = smallScene();
+  j["stages"][0]["max_steps"] = 50;
+  Runner r(parseScene(j, "test.json"));
+  try {
+    while (r.advance(1000)) {
+    }
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("max_steps"), std::string::npos);
+  }
+}
+
+TEST(RunnerCheckpoint, RestartMidCycleIsBitIdentical) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("fl-runner-ckpt-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  json j = smallScene();
+  j["stages"].push_back({{"type", "cyclic"}, {"drainage", "undrained"}, {"amplitude", 2.3e-4}, {"cycles", 2},
+                         {"strain_rate", 0.5}});
+  Runner a(parseScene(j, "test.json"));
+  while (a.stageIndex() < 1 || a.currentCycle() < 1) a.advance(100);
+  a.advance(777);  // somewhere inside cycle 1
+  const std::string ck = (dir / "mid.ckpt").string();
+  a.writeCheckpoint(ck);
+  Runner b = Runner::fromCheckpoint(ck);
+  while (a.advance(1000)) {
+  }
+  while (b.advance(1000)) {
+  }
+  const auto& pa = a.simulation().particles();
+  const auto& pb = b.simulation().particles();
+  EXPECT_EQ(a.simulation().stepCount(), b.simulation().stepCount());
+  EXPECT_EQ(std::memcmp(pa.pos.data(), pb.pos.data(), pa.pos.size() * sizeof(Vec3)), 0);
+  EXPECT_EQ(std::memcmp(pa.vel.data(), pb.vel.data(), pa.vel.size() * sizeof(Vec3)), 0);
+  ASSERT_EQ(a.cycles().size(), b.cycles().size());
+  EXPECT_EQ(a.cycles().back().Gsec, b.cycles().back().Gsec);
+  // corrupted and truncated checkpoints are rejected with a clear message
+  std::string bytes;
+  {
+    std::ifstream in(ck, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  auto expectRejected = [&](const std::string& content, const std::string& fragment) {
+    const std::string bad = (dir / "bad.ckpt").string();
+    std::ofstream(bad, std::ios::binary) << content;
+    try {
+      (void)Runner::fromCheckpoint(bad);
+      ADD_FAILURE() << "accepted: " << fragment;
+    } catch (const IoError& e) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+  };
+  std::string flipped = bytes;
+  flipped[bytes.size() / 2] ^= 0x5A;
+  expectRejected(flipped, "checksum");
+  expectRejected(bytes.substr(0, bytes.size() - 100), "truncated");
+  expectRejected("hello", "not a FabricLab checkpoint");
+  std::string version = bytes;
+  version[sizeof("FABRICLAB-CHECKPOINT")] = 99;
+  expectRejected(version, "version");
+  fs::remove_all(dir);
+}
+
+TEST(RunnerSpecimen, AStageCanStartFromAnotherRunsCheckpoint) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("fl-runner-branch-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  json j = smallScene();
+  j["output"]["directory"] = dir.string();
+  Runner a = run(j);
+  ASSERT_EQ(a.summaries().size(), 1u);
+  const std::string ck = a.summaries()[0].checkpoint;
+  ASSERT_TRUE(fs::exists(ck));
+  // branch: the same specimen, another history, other numerics
+  json k = smallScene();
+  k["specimen"] = {{"source", "checkpoint"}, {"path", ck}};
+  k["numerics"]["density_scale"] = 50;
+  k["stages"] = json::array({{{"type", "k0"}, {"axial_stress", 100000}}});
+  Runner b(parseScene(k, "branch.json"));
+  EXPECT_NEAR(stressMeasures(b.simulation().contactStress()).p / 50000, 1.0, 2e-3);
+  EXPECT_EQ(b.simulation().numerics().densityScale, 50);
+  while (b.advance(5000)) {
+  }
+  EXPECT_NEAR(b.summaries()[0].end.stress.z() / 100000, 1.0, 2e-3);
+  fs::remove_all(dir);
+}
