@@ -26,6 +26,12 @@ namespace {
 std::atomic<int> g_signal{0};
 extern "C" void onSignal(int s) { g_signal.store(s); }
 
+// Prints run-time warnings (leaving the quasi-static regime, energy drift, time-step changes).
+class WarningPrinter final : public RunObserver {
+ public:
+  void onWarning(const std::string& m) override { std::fprintf(stderr, "\nwarning: %s\n", m.c_str()); }
+};
+
 void usage(std::FILE* f) {
   std::fprintf(f,
                "usage: fabriclab-run SCENE.json [options]      run a scene headless\n"
@@ -151,6 +157,8 @@ int runHeadless(int argc, char** argv) {
       outputs = std::make_unique<RunOutputs>(scene.output.directory, scene);
       run->addObserver(outputs.get());
     }
+    WarningPrinter warnings;
+    run->addObserver(&warnings);
     const Simulation& sim = run->simulation();
     std::printf("FabricLab: scene '%s', %zu particles, %d stages, %d threads, dt %.3g s (%.2f of Rayleigh), "
                 "density scale %g\n",
@@ -204,6 +212,9 @@ int runHeadless(int argc, char** argv) {
   } catch (const InputError& e) {
     std::fprintf(stderr, "fabriclab-run: input error: %s\n", e.what());
     return 2;
+  } catch (const InstabilityError& e) {
+    std::fprintf(stderr, "\nfabriclab-run: stopped: %s\n", e.what());
+    return 3;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "fabriclab-run: error: %s\n", e.what());
     return 1;

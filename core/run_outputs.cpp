@@ -58,12 +58,14 @@ RunOutputs::RunOutputs(const std::string& directory, const Scene& scene)
     : m_dir(directory),
       m_series((std::filesystem::path(directory) / "timeseries.csv").string(), timeSeriesHeader()),
       m_cycles((std::filesystem::path(directory) / "cycles.csv").string(), cycleHeader()),
+      m_warnings((std::filesystem::path(directory) / "warnings.txt").string(), "# run-time warnings"),
       m_sceneName(scene.name) {
   writeFileAtomically((std::filesystem::path(directory) / "scene.json").string(), sceneToJson(scene) + "\n");
 }
 
 void RunOutputs::onSample(const Sample& s) { m_series.append(timeSeriesRow(s)); }
 void RunOutputs::onCycle(const CycleRecord& c) { m_cycles.append(cycleRow(c)); }
+void RunOutputs::onWarning(const std::string& message) { m_warnings.append(message); }
 
 void RunOutputs::onStageEnd(const StageSummary& s) {
   m_stages.push_back(s);

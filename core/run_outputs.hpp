@@ -20,6 +20,7 @@ class RunOutputs final : public RunObserver {
   void onSample(const Sample& s) override;
   void onCycle(const CycleRecord& c) override;
   void onStageEnd(const StageSummary& s) override;
+  void onWarning(const std::string& message) override;
 
   static std::string timeSeriesHeader();
   static std::string timeSeriesRow(const Sample& s);
@@ -30,6 +31,7 @@ class RunOutputs final : public RunObserver {
   std::string m_dir;
   AppendLog m_series;
   AppendLog m_cycles;
+  AppendLog m_warnings;
   std::vector<StageSummary> m_stages;
   std::string m_sceneName;
 };

@@ -77,7 +77,7 @@ Runner::Runner(Scene scene) : m_scene(std::move(scene)) {
       break;
     }
   }
-  m_energyBalance0 = m_sim->energy().balance();
+  m_configuredTimeStep = m_sim->timeStep();
 }
 
 Runner::~Runner() = default;
@@ -110,6 +110,7 @@ void Runner::startStage() {
   m_quarter = 0;
   m_lastSampleStrain = 0;
   m_stageDone = false;
+  m_warned = 0;
   m_stageWallStart = wallSeconds();
   m_stageH0 = m_sim->cell().matrix();
   const StressMeasures s0 = stressMeasures(m_sim->contactStress());
@@ -295,6 +296,14 @@ bool Runner::advance(long maxSteps) {
     if (!m_stageStarted) startStage();
     m_sim->step();
     ++m_stageSteps;
+    if (!m_energyBaselineSet) {
+      // after the first contact pass of this run: a specimen branched into another material carries
+      // elastic energies computed with the old stiffness until then
+      m_energyBalance0 = m_sim->energy().balance();
+      m_energyBaselineSet = true;
+    }
+    checkEveryStep();
+    if (m_stageSteps % m_scene.output.checkInterval == 0) checkPeriodically();
     stepStage();
     const OutputSpec& out = m_scene.output;
     if (!out.directory.empty()) {
@@ -325,6 +334,96 @@ double Runner::stageProgress() const {
       return target > 0 ? std::clamp(p / target, 0.0, 1.0) : 0.0;
     }
   }
+}
+
+// ---- guards (issue: numerical stability) -----------------------------------------------------------
+// O(1) per step: non-finite stress or cell, runaway overlap.
+void Runner::checkEveryStep() {
+  const Simulation& sim = *m_sim;
+  const Mat3& s = sim.contactStress();
+  if (!s.allFinite() || !sim.cell().matrix().allFinite())
+    blowUp("NaN/Inf in the stress or the cell", "reduce numerics.time_step_factor or enable guards.adaptive_time_step");
+  const double ov = sim.diagnostics().maxOverlapRatio;
+  if (!(ov <= m_scene.guards.maxOverlapRatio)) {
+    std::ostringstream o;
+    o << "an overlap reached " << ov << " of the particle radius (limit guards.max_overlap_ratio = "
+      << m_scene.guards.maxOverlapRatio << ")";
+    blowUp(o.str(), "the particles are too soft for this stress or the loading too fast: raise material.shear_modulus, "
+                    "lower the target stress or the strain rate, or raise guards.max_overlap_ratio if intended");
+  }
+}
+
+// Every check interval: the time step follows the contact stiffness; energy must not be created.
+void Runner::checkPeriodically() {
+  Simulation& sim = *m_sim;
+  const GuardSettings& g = m_scene.guards;
+  if (g.adaptiveTimeStep) {
+    const double limit = g.stiffnessSafety * sim.stiffnessTimeStep();
+    const double want = std::min(m_configuredTimeStep, limit);
+    // shrink at once, grow back only by a clear margin (avoids flapping)
+    if (want < sim.timeStep() || want > 1.05 * sim.timeStep()) {
+      if (want < sim.timeStep()) {
+        std::ostringstream o;
+        o << "time step reduced to " << want << " s (contacts stiffened: stiffness-based critical step "
+          << sim.stiffnessTimeStep() << " s)";
+        warnOnce(1, o.str());
+      }
+      sim.setTimeStep(want);
+      ++m_timeStepChanges;
+    }
+  }
+  if (sim.numerics().trackEnergy && m_energyBaselineSet) {
+    const EnergyLedger& en = sim.energy();
+    const double scale = std::max({std::abs(en.boundaryWork), en.dissipated(), en.stored(), 1e-300});
+    const double err = std::abs(en.balance() - m_energyBalance0) / scale;
+    if (!std::isfinite(err)) blowUp("NaN/Inf in the energy (a particle's velocity or position)",
+                                    "reduce numerics.time_step_factor or enable guards.adaptive_time_step");
+    if (err > g.maxEnergyError && en.balance() > m_energyBalance0) {
+      std::ostringstream o;
+      o << "the energy balance broke: " << err << " of the energy turnover was created (limit guards.max_energy_error = "
+        << g.maxEnergyError << ")";
+      blowUp(o.str(), "reduce numerics.time_step_factor, enable guards.adaptive_time_step, or add damping");
+    }
+    if (err > g.warnEnergyError) {
+      std::ostringstream o;
+      o << "energy balance error " << err << " exceeds guards.warn_energy_error = " << g.warnEnergyError;
+      warnOnce(2, o.str());
+    }
+  }
+  const StageSpec* st = currentStage();
+  if (st && m_stageStarted) {
+    const double p = stressMeasures(sim.contactStress()).p;
+    const double I = inertialNumber(sim, p);
+    if (p > 0 && I > g.warnInertialNumber && m_sim->diagnostics().contacts > 0) {
+      std::ostringstream o;
+      o << "stage '" << st->name << "' runs at inertial number " << I << " > " << g.warnInertialNumber
+        << ": not quasi-static; lower the strain rate or the servo's max_inertial_number";
+      warnOnce(4, o.str());
+    }
+  }
+}
+
+void Runner::warnOnce(int kind, const std::string& message) {
+  if (m_warned & kind) return;
+  m_warned |= kind;
+  for (auto* o : m_observers) o->onWarning(message);
+}
+
+void Runner::blowUp(const std::string& cause, const std::string& fix) {
+  std::ostringstream o;
+  o << "numerical instability at step " << m_sim->stepCount() << " (t = " << m_sim->time() << " s, dt = "
+    << m_sim->timeStep() << " s, stage '" << (currentStage() ? currentStage()->name : std::string("-"))
+    << "'): " << cause << ". To fix: " << fix << ".";
+  if (!m_scene.output.directory.empty()) {
+    const std::string ck = checkpointPath("diagnostic-step-" + std::to_string(m_sim->stepCount()));
+    try {
+      writeCheckpoint(ck);
+      o << " Diagnostic checkpoint: " << ck;
+    } catch (const std::exception& e) {
+      o << " (diagnostic checkpoint failed: " << e.what() << ")";
+    }
+  }
+  throw InstabilityError(o.str());
 }
 
 // ---- measurement --------------------------------------------------------------------------------
@@ -364,7 +463,7 @@ Sample Runner::measure() {
   s.dissipated = en.dissipated();
   s.boundaryWork = en.boundaryWork;
   const double scale = std::max({std::abs(en.boundaryWork), en.dissipated(), en.stored(), 1e-300});
-  s.energyError = std::abs(en.balance() - m_energyBalance0) / scale;
+  s.energyError = m_energyBaselineSet ? std::abs(en.balance() - m_energyBalance0) / scale : 0.0;
   s.timeStep = sim.timeStep();
   s.timeStepMargin = sim.timeStep() / sim.stiffnessTimeStep();
   s.friction = sim.materials()[0].friction;
@@ -409,6 +508,9 @@ void Runner::writeCheckpoint(const std::string& path) const {
   w.put(m_failureCycle);
   w.put(m_stageDone);
   w.put(m_energyBalance0);
+  w.put(m_energyBaselineSet);
+  w.put(m_configuredTimeStep);
+  w.put(m_timeStepChanges);
   w.put(m_analyzer.initialPressure());
   w.put(m_analyzer.firstStiffness());
   w.put(m_analyzer.failure());
@@ -486,6 +588,10 @@ Runner Runner::fromCheckpoint(const std::string& path) {
   run.m_failureCycle = r.get<int>("failure cycle");
   run.m_stageDone = r.get<bool>("stage done");
   run.m_energyBalance0 = r.get<double>("initial energy balance");
+  run.m_energyBaselineSet = r.get<bool>("energy baseline set");
+  run.m_configuredTimeStep = r.get<double>("configured time step");
+  run.m_timeStepChanges = r.get<long>("time step changes");
+  if (!(run.m_configuredTimeStep > 0)) r.fail("configured time step must be > 0");
   const double p0 = r.get<double>("cycle p0");
   const double g1 = r.get<double>("cycle G1");
   const FailureCriteria fc = r.get<FailureCriteria>("failure criteria");

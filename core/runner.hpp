@@ -57,6 +57,9 @@ class RunObserver {
   virtual void onCycle(const CycleRecord& /*c*/) {}
   virtual void onStageEnd(const StageSummary& /*s*/) {}
   virtual void onFinished() {}
+  // Run-time honesty: leaving the quasi-static regime, energy drift, time-step changes (once per kind
+  // and stage).
+  virtual void onWarning(const std::string& /*message*/) {}
 };
 
 class Runner {
@@ -103,6 +106,10 @@ class Runner {
   double axialRate(const StageSpec& st) const;
   void applyFriction(double mu);
   void writeVtk();
+  void checkEveryStep();
+  void checkPeriodically();
+  [[noreturn]] void blowUp(const std::string& cause, const std::string& fix);
+  void warnOnce(int kind, const std::string& message);
 
   Scene m_scene;
   std::unique_ptr<Simulation> m_sim;
@@ -126,9 +133,15 @@ class Runner {
   int m_failureCycle = 0;
   double m_stageWallStart = 0;
   bool m_stageDone = false;
-  double m_energyBalance0 = 0;        // energy balance at the start of the run
+  double m_energyBalance0 = 0;        // energy balance after the first step of the run
+  bool m_energyBaselineSet = false;
   CycleAnalyzer m_analyzer;
-  std::array<std::unique_ptr<PvdCollection>, 3> m_pvd;  // particles, contacts, cell series
+  std::array<std::unique_ptr<PvdCollection>, 3> m_pvd;
+  double m_configuredTimeStep = 0;    // dt from the scene; the adaptive step never exceeds it [s]
+  long m_timeStepChanges = 0;
+  unsigned m_warned = 0;              // bit per warning kind, reset at each stage
+ public:
+  long timeStepChanges() const { return m_timeStepChanges; }  // particles, contacts, cell series
 };
 
 }  // namespace fl

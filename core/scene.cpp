@@ -136,6 +136,19 @@ std::vector<SchemaField> makeSchema() {
                   "A cycle fails when its minimum p' < this x p' at the start of cycling."));
   s.push_back(num("failure", "min_stiffness_fraction", "-", "0.2", 0, 1, false, false,
                   "A cycle fails when its G_sec < this x G_sec of cycle 1."));
+  // guards
+  s.push_back(boolean("guards", "adaptive_time_step", "true",
+                      "Shrink the time step when contacts stiffen (Hertz) so that dt <= stiffness_safety x 2 sqrt(m*/k)."));
+  s.push_back(num("guards", "stiffness_safety", "-", "0.35", 0, 1, true, false,
+                  "Fraction of the stiffness-based critical step allowed for dt."));
+  s.push_back(num("guards", "max_overlap_ratio", "-", "0.05", 0, 1, true, false,
+                  "Stop (with a diagnostic checkpoint) when an overlap exceeds this fraction of the smaller radius."));
+  s.push_back(num("guards", "max_energy_error", "-", "0.25", 0, 1e6, true, false,
+                  "Stop when the energy balance error exceeds this (energy created: the integration is unstable)."));
+  s.push_back(num("guards", "warn_inertial_number", "-", "1e-3", 0, 1e6, true, false,
+                  "Warn when a loading stage runs above this inertial number (no longer quasi-static)."));
+  s.push_back(num("guards", "warn_energy_error", "-", "0.01", 0, 1e6, true, false,
+                  "Warn when the energy balance error exceeds this."));
   // stages: 'type' and 'name' for all; the rest per type
   for (const auto& t : kStageTypes) {
     const std::string sec = "stage:" + t;
@@ -282,12 +295,12 @@ const std::vector<SchemaField>& sceneSchema() {
 
 Scene parseScene(const json& j, const std::string& file, const std::string& baseDir) {
   if (!j.is_object()) throw InputError(file + ": the scene must be a JSON object");
-  static const std::set<std::string> sections = {"name", "material", "specimen", "numerics", "servo",
-                                                 "output", "failure", "stages"};
+  static const std::set<std::string> sections = {"name",   "material", "specimen", "numerics", "servo",
+                                                 "output", "failure",  "guards",   "stages"};
   for (auto it = j.begin(); it != j.end(); ++it)
     if (!sections.count(it.key()))
       throw InputError(file + ": unknown section '" + it.key() +
-                       "'; allowed: name, material, specimen, numerics, servo, stages, output, failure");
+                       "'; allowed: name, material, specimen, numerics, servo, stages, output, failure, guards");
   Scene s;
   s.file = file;
   {
@@ -346,6 +359,13 @@ Scene parseScene(const json& j, const std::string& file, const std::string& base
   const json fa = section("failure");
   s.failure.minPressureFraction = fa.at("min_pressure_fraction");
   s.failure.minStiffnessFraction = fa.at("min_stiffness_fraction");
+  const json gu = section("guards");
+  s.guards.adaptiveTimeStep = gu.at("adaptive_time_step");
+  s.guards.stiffnessSafety = gu.at("stiffness_safety");
+  s.guards.maxOverlapRatio = gu.at("max_overlap_ratio");
+  s.guards.maxEnergyError = gu.at("max_energy_error");
+  s.guards.warnInertialNumber = gu.at("warn_inertial_number");
+  s.guards.warnEnergyError = gu.at("warn_energy_error");
   // stages
   const json stages = j.value("stages", json::array());
   if (!stages.is_array()) throw InputError(file + ": 'stages' must be a list");
@@ -479,6 +499,12 @@ std::string sceneToJson(const Scene& s) {
                  {"check_interval", s.output.checkInterval}};
   j["failure"] = {{"min_pressure_fraction", s.failure.minPressureFraction},
                   {"min_stiffness_fraction", s.failure.minStiffnessFraction}};
+  j["guards"] = {{"adaptive_time_step", s.guards.adaptiveTimeStep},
+                 {"stiffness_safety", s.guards.stiffnessSafety},
+                 {"max_overlap_ratio", s.guards.maxOverlapRatio},
+                 {"max_energy_error", s.guards.maxEnergyError},
+                 {"warn_inertial_number", s.guards.warnInertialNumber},
+                 {"warn_energy_error", s.guards.warnEnergyError}};
   json st = json::array();
   for (const StageSpec& g : s.stages) {
     json o = {{"type", stageTypeName(g.type)}, {"name", g.name}, {"max_steps", g.maxSteps}};

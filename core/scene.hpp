@@ -37,6 +37,17 @@ struct OutputSpec {
   long checkInterval = 100;         // steps between completion checks (unbalanced force is O(N))
 };
 
+// Numerical guards (runner): the time step follows the contact stiffness, blow-ups stop the run with a
+// diagnostic checkpoint, and leaving the quasi-static regime or drifting energy is warned about.
+struct GuardSettings {
+  bool adaptiveTimeStep = true;    // keep dt <= stiffnessSafety x 2 sqrt(m*/k_max)
+  double stiffnessSafety = 0.35;   // [-]
+  double maxOverlapRatio = 0.05;   // stop when delta / r exceeds this [-]
+  double maxEnergyError = 0.25;    // stop when the energy balance error exceeds this (energy created) [-]
+  double warnInertialNumber = 1e-3;  // warn above this inertial number in loading stages [-]
+  double warnEnergyError = 0.01;     // warn above this energy balance error [-]
+};
+
 struct Scene {
   std::string name;
   std::string file;  // the file it came from ("" if built in code)
@@ -48,6 +59,7 @@ struct Scene {
   std::vector<StageSpec> stages;
   OutputSpec output;
   FailureCriteria failure;
+  GuardSettings guards;
 };
 
 // One schema entry.

@@ -2,6 +2,9 @@
 // checking that the message names the file, the field and what is allowed.
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
+
 #include <nlohmann/json.hpp>
 
 #include "core/errors.hpp"
@@ -125,4 +128,11 @@ TEST(SceneErrors, FileSourceNeedsAPath) {
 
 TEST(SceneErrors, NotJsonNamesTheFile) {
   EXPECT_THROW(loadScene("/nonexistent/scene.json"), IoError);
+}
+
+TEST(SceneFile, CommittedReferenceDocumentIsCurrent) {
+  // docs/scene-reference.md is generated from the schema; regenerate with `fabriclab-run --schema-doc FILE`
+  std::ifstream in(std::string(FL_SOURCE_DIR) + "/docs/scene-reference.md");
+  const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(doc, sceneReferenceMarkdown()) << "run: fabriclab-run --schema-doc docs/scene-reference.md";
 }
