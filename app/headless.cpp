@@ -78,6 +78,23 @@ void printSummary(const Runner& run) {
     std::printf("%-34.34s %8.1f %7.1f %6.3f %6.3f %7.3f %7.4f %6.4f %6.3f %9.3f\n", s.name.c_str(), s.end.p / 1e3,
                 s.end.q / 1e3, s.end.voidRatio, s.end.Z, s.end.Zm, s.end.a2D, s.end.a3D, s.K0, s.ocr);
   std::printf("(a_2D: Rothenburg–Bathurst on vertical planes, a_3D = 5/2 (phi_zz - phi_xx); e from cell volume)\n");
+  // where the time went, per pipeline stage: features a scene does not enable do not appear here
+  const StageProfile& prof = run.simulation().profile();
+  std::printf("profile (%ld steps, %ld neighbour rebuilds):", prof.steps, prof.rebuilds);
+  for (int k = 0; k < static_cast<int>(Stage::Count); ++k)
+    std::printf(" %s %.1f%%", stageName(static_cast<Stage>(k)), 100.0 * prof.seconds[k] / std::max(prof.total(), 1e-300));
+  std::printf("\n");
+  if (!run.samples().empty()) {
+    double maxI = 0, maxErr = 0, maxMargin = 0;
+    for (const Sample& s : run.samples()) {
+      maxI = std::max(maxI, s.inertialNumber);
+      maxErr = std::max(maxErr, s.energyError);
+      maxMargin = std::max(maxMargin, s.timeStepMargin);
+    }
+    std::printf("honesty: max inertial number %.2g, max energy-balance error %.2g, max dt / critical step %.2g, "
+                "final unbalanced force ratio %.2g, dt changes %ld\n",
+                maxI, maxErr, maxMargin, run.samples().back().unbalanced, run.timeStepChanges());
+  }
   if (!run.cycles().empty()) {
     const CycleRecord& f = run.cycles().front();
     const CycleRecord& l = run.cycles().back();

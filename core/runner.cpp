@@ -16,6 +16,7 @@
 #include "binary_io.hpp"
 #include "cell_control.hpp"
 #include "errors.hpp"
+#include "invariants.hpp"
 #include "measurements.hpp"
 #include "packing_io.hpp"
 #include "vtk_xml_writer.hpp"
@@ -303,6 +304,9 @@ bool Runner::advance(long maxSteps) {
       m_energyBaselineSet = true;
     }
     checkEveryStep();
+#ifdef FL_VALIDATION
+    checkInvariants(*m_sim);
+#endif
     if (m_stageSteps % m_scene.output.checkInterval == 0) checkPeriodically();
     stepStage();
     const OutputSpec& out = m_scene.output;

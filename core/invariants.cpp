@@ -1,0 +1,52 @@
+#include "invariants.hpp"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "errors.hpp"
+
+namespace fl {
+
+namespace {
+[[noreturn]] void violated(const std::string& what) { throw Error("invariant violated: " + what); }
+}  // namespace
+
+void checkInvariants(const Simulation& sim) {
+  const ParticleStore& p = sim.particles();
+  const ContactStore& c = sim.contacts();
+  const std::size_t n = p.size();
+  for (std::size_t i = 0; i < n; ++i)
+    if (!p.pos[i].allFinite() || !p.vel[i].allFinite() || !p.angVel[i].allFinite() || !p.force[i].allFinite())
+      violated("particle " + std::to_string(i) + " has a non-finite position, velocity or force");
+  if (!(sim.cell().volume() > 0.0)) violated("cell volume <= 0");
+  std::vector<int> seen(n, 0);
+  for (std::size_t k = 0; k < c.size(); ++k) {
+    const int i = c.first[k], j = c.second[k];
+    if (i < 0 || j <= i || static_cast<std::size_t>(j) >= n) violated("pair " + std::to_string(k) + " indices");
+    ++seen[i];
+    ++seen[j];
+    if (!c.active(k)) continue;
+    if (std::abs(c.normal[k].norm() - 1.0) > 1e-12) violated("pair " + std::to_string(k) + " normal not unit");
+    const double R = p.radius[i] + p.radius[j];
+    if (std::abs(c.distance[k] + c.overlap[k] - R) > 1e-12 * R) violated("pair " + std::to_string(k) + " overlap");
+    const Vec3& ft = c.history[k].tangentialForce;
+    // round-off of the projection scales with the contact's forces, not with |F_t| (which may be ~0)
+    if (std::abs(ft.dot(c.normal[k])) > 1e-9 * ft.norm() + 1e-12 * c.normalForce[k] + 1e-300)
+      violated("pair " + std::to_string(k) + " tangential force out of the tangent plane");
+    const double mu = sim.materials()[p.material[i]].friction;
+    if (ft.norm() > mu * c.normalForce[k] * (1 + 1e-9) + 1e-300)
+      violated("pair " + std::to_string(k) + " tangential force above the Coulomb limit");
+  }
+  if (c.adjStart.size() != n + 1 || c.adjEntry.size() != 2 * c.size()) violated("adjacency sizes");
+  for (std::size_t i = 0; i < n; ++i) {
+    if (c.adjStart[i + 1] - c.adjStart[i] != seen[i]) violated("adjacency of particle " + std::to_string(i));
+    for (int e = c.adjStart[i]; e < c.adjStart[i + 1]; ++e) {
+      const int entry = c.adjEntry[e], pair = entry >> 1;
+      const int self = (entry & 1) ? c.second[pair] : c.first[pair];
+      if (self != static_cast<int>(i)) violated("adjacency entry of particle " + std::to_string(i));
+    }
+  }
+}
+
+}  // namespace fl
