@@ -18,7 +18,7 @@ TEST(Invariants, HoldOnACompressedFrictionalPackingAndCatchCorruption) {
   Mat3 L = Mat3::Zero();
   L.diagonal().setConstant(-300);
   sim.setVelocityGradient(L);
-  for (int k = 0; k < 30; ++k) {
+  for (int k = 0; k < 60; ++k) {
     sim.run(100);
     EXPECT_NO_THROW(checkInvariants(sim));
   }
