@@ -1,9 +1,16 @@
 #!/usr/bin/env bash
 # The README's first command: install dependencies, build, and start FabricLab on the default scene.
-# Extra arguments are passed to the program.
+# With no display (ssh, CI) it runs the same scene headless instead and says so.
+# Extra arguments are passed to the program (e.g. another scene file).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 "$root/scripts/install-deps.sh"
 "$root/scripts/build.sh"
 build="${FL_BUILD_DIR:-$root/build}"
-exec "$build/app/fabriclab-run" "$@"
+scene="$root/resources/scenes/default.json"
+if [ $# -gt 0 ]; then scene="$1"; shift; fi
+if [ -z "${DISPLAY:-}" ] && [ -z "${WAYLAND_DISPLAY:-}" ]; then
+  echo "run-app: no display found; running the scene headless (fabriclab --headless)"
+  exec "$build/app/fabriclab" --headless "$scene" "$@"
+fi
+exec "$build/app/fabriclab" "$scene" "$@"
