@@ -37,15 +37,26 @@ class BinaryWriter {
   std::string m_buf;
 };
 
+// Reads from <bytes>, which must outlive the reader; a temporary (e.g. bytes.substr(...)) is copied into
+// the reader instead, so `BinaryReader r(s.substr(a, b), ...)` cannot leave a dangling reference.
+// Not copyable or movable (it may point into its own storage).
 class BinaryReader {
  public:
   BinaryReader(const std::string& bytes, std::string source, std::size_t baseOffset = 0)
       : m_buf(bytes), m_source(std::move(source)), m_base(baseOffset) {}
+  BinaryReader(std::string&& bytes, std::string source, std::size_t baseOffset = 0)
+      : m_own(std::move(bytes)), m_buf(m_own), m_source(std::move(source)), m_base(baseOffset) {}
+  BinaryReader(const BinaryReader&) = delete;
+  BinaryReader& operator=(const BinaryReader&) = delete;
 
   template <class T>
   T get(const char* field) {
     static_assert(std::is_trivially_destructible_v<T> && std::is_standard_layout_v<T>);  // POD-like (Eigen fixed-size included)
     need(sizeof(T), field);
+    if constexpr (std::is_same_v<T, bool>) {  // a byte other than 0/1 is corruption (and UB to load as bool)
+      const auto b = static_cast<unsigned char>(m_buf[m_pos]);
+      if (b > 1) fail(std::string("invalid value ") + std::to_string(b) + " for the flag " + field);
+    }
     T v;
     std::memcpy(static_cast<void*>(&v), m_buf.data() + m_pos, sizeof(T));
     m_pos += sizeof(T);
@@ -75,6 +86,7 @@ class BinaryReader {
   void need(std::size_t n, const char* field) const {
     if (m_buf.size() - m_pos < n) fail(std::string("truncated while reading ") + field);
   }
+  std::string m_own;  // the bytes, when the reader was given a temporary
   const std::string& m_buf;
   std::string m_source;
   std::size_t m_base;

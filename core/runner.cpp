@@ -602,6 +602,11 @@ Runner Runner::fromCheckpoint(const std::string& path) {
   auto pts = r.getVector<CyclePoint>("cycle points");
   run.m_analyzer.restore(p0, g1, fc, std::move(pts));
   run.m_cycles = r.getVector<CycleRecord>("cycle records");
+  for (const CycleRecord& c : run.m_cycles) {  // inspect the flag's byte without loading it as a bool
+    unsigned char b;
+    std::memcpy(&b, &c.failed, 1);
+    if (b > 1) r.fail("invalid failure flag in the cycle records");
+  }
   if (run.m_stage < 0 || run.m_stage > static_cast<int>(run.m_scene.stages.size()) || run.m_quarter < 0 || run.m_quarter > 3)
     r.fail("invalid stage state");
   const bool servo = r.get<bool>("servo present");
@@ -610,7 +615,12 @@ Runner Runner::fromCheckpoint(const std::string& path) {
   bool iso = false;
   Vec3 rate = Vec3::Zero();
   if (servo) {
-    for (int k = 0; k < 3; ++k) axes[k] = r.get<AxisControl>("servo axis");
+    for (int k = 0; k < 3; ++k) {
+      axes[k] = r.get<AxisControl>("servo axis");
+      int mode;
+      std::memcpy(&mode, &axes[k].mode, sizeof mode);
+      if (mode < 0 || mode > static_cast<int>(AxisMode::MeanStress)) r.fail("invalid servo axis mode");
+    }
     ss = r.get<ServoSettings>("servo settings");
     iso = r.get<bool>("servo isochoric");
     rate = r.get<Vec3>("servo strain rate");

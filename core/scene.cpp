@@ -459,7 +459,7 @@ Scene loadScene(const std::string& path) {
   json j;
   try {
     j = json::parse(in, nullptr, true, /*ignore_comments=*/true);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse_error, or out_of_range for a number like 1e999
     throw InputError(path + ": not valid JSON: " + e.what());
   }
   return parseScene(j, path, std::filesystem::path(path).parent_path().string());

@@ -4,7 +4,8 @@
 # Usage: scripts/install-deps.sh [--core-only]   (--core-only: no Qt/VTK, for cluster nodes)
 set -euo pipefail
 
-core=(cmake g++ make libeigen3-dev nlohmann-json3-dev libgtest-dev libbenchmark-dev)
+core=(cmake g++ make libeigen3-dev nlohmann-json3-dev libgtest-dev libbenchmark-dev
+      clang libclang-rt-14-dev libomp-14-dev)  # clang, libFuzzer, libomp+Archer: scripts/ci-reliability.sh
 gui=(qt6-base-dev libqt6opengl6-dev qt6-charts-dev libvtk9-dev xvfb xauth libgl1-mesa-dri)
 
 want=("${core[@]}")

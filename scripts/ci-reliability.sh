@@ -1,0 +1,86 @@
+#!/usr/bin/env bash
+# Reliability pass of CI (issue 8), after the normal build and tests:
+#   1. ASan + UBSan (g++) build of the engine, the headless command and every engine test, incl. the
+#      crash-safety test (tests/crash: SIGKILL at random moments, SIGINT/SIGTERM, output-folder safety);
+#   2. TSan of the OpenMP core: clang + LLVM libomp with the Archer OMPT tool (libarcher), so OpenMP
+#      synchronisation is visible to TSan (g++'s libgomp is not instrumented and gives false positives),
+#      running the multi-threaded tests with 2 threads; then the GUI engineer's hook, if present;
+#   3. a short libFuzzer pass over every reader (scripts/fuzz.sh, FL_FUZZ_SECONDS per target, default 25).
+# Prints the time of each step. Env: FL_ASAN_BUILD_DIR (default build-asan), FL_TSAN_BUILD_DIR (build-tsan),
+# FL_FUZZ_BUILD (build-fuzz), FL_JOBS (2), FL_RELIABILITY_SKIP (space-separated: asan tsan fuzz gui-tsan).
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+jobs="${FL_JOBS:-2}"
+skip=" ${FL_RELIABILITY_SKIP:-} "
+asan="${FL_ASAN_BUILD_DIR:-$root/build-asan}"
+tsan="${FL_TSAN_BUILD_DIR:-$root/build-tsan}"
+export FL_FUZZ_BUILD="${FL_FUZZ_BUILD:-$root/build-fuzz}"
+t_start=$SECONDS
+report=()
+step() { report+=("$(printf '%-34s %5d s  %s' "$1" "$2" "$3")"); echo "== ci-reliability: $1: $3 ($2 s)"; }
+
+# Sanitizer reports fail the test that triggers them (g++'s UBSan would otherwise only print).
+export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1"
+export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+export OMP_WAIT_POLICY=passive
+
+configure() {  # dir, extra cmake args...
+  local dir="$1"; shift
+  cmake -S "$root" -B "$dir" -DFL_BUILD_GUI=OFF -DFL_BUILD_BENCH=OFF -DFL_BUILD_TESTS=ON \
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo "$@" >"$dir.configure.log" 2>&1 || { tail -30 "$dir.configure.log"; exit 1; }
+}
+
+# ---- 1. ASan + UBSan: every engine test and the crash-safety test ----------------------------------------
+if [[ "$skip" != *" asan "* ]]; then
+  t=$SECONDS
+  mkdir -p "$asan"
+  configure "$asan" -DFL_SANITIZE=address,undefined
+  cmake --build "$asan" -j "$jobs" >"$asan/build.log" 2>&1 || { tail -40 "$asan/build.log"; exit 1; }
+  b=$((SECONDS - t)); t=$SECONDS
+  (cd "$asan" && ctest --output-on-failure -j "$jobs" --timeout 900 >"$asan/ctest.log" 2>&1) \
+    || { grep -E "tests passed|Failed|\*\*\*|ERROR|runtime error" "$asan/ctest.log" | head -40; exit 1; }
+  step "asan+ubsan build" "$b" "ok"
+  step "asan+ubsan ctest (engine + crash)" $((SECONDS - t)) "$(grep -E 'tests passed' "$asan/ctest.log")"
+  grep -h '\[crash-safety\]' "$asan"/Testing/Temporary/LastTest.log 2>/dev/null | head -1 || true
+fi
+
+# ---- 2. TSan on the OpenMP core (clang + libomp + Archer) ------------------------------------------------
+if [[ "$skip" != *" tsan "* ]]; then
+  archer="$(ls /usr/lib/llvm-*/lib/libarcher.so 2>/dev/null | sort -V | tail -1 || true)"
+  if command -v clang++ >/dev/null && [ -n "$archer" ]; then
+    t=$SECONDS
+    mkdir -p "$tsan"
+    CC=clang CXX=clang++ configure "$tsan" -DFL_SANITIZE=thread  # Debian's clang: -fopenmp = LLVM libomp
+    cmake --build "$tsan" -j "$jobs" --target core_tests >"$tsan/build.log" 2>&1 \
+      || { tail -40 "$tsan/build.log"; exit 1; }
+    b=$((SECONDS - t)); t=$SECONDS
+    # The tests that run OpenMP regions with more than one thread (parallel contact pass, gather, neighbour
+    # grid) plus restart; 2 threads on this 2-core machine.
+    filter="Determinism.*:NeighbourSearch.*:Restart.*:Conservation.LinearMomentumToRoundOff:RunnerCheckpoint.*"
+    OMP_NUM_THREADS=2 OMP_TOOL_LIBRARIES="$archer" ARCHER_OPTIONS="verbose=0" \
+      TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1" \
+      "$tsan/tests/core_tests" --gtest_filter="$filter" >"$tsan/tsan.log" 2>&1 \
+      || { grep -E "WARNING: ThreadSanitizer|FAILED|#[0-9]+ " "$tsan/tsan.log" | head -40; exit 1; }
+    step "tsan build (clang, libomp)" "$b" "ok"
+    step "tsan run (OpenMP core, 2 threads)" $((SECONDS - t)) "$(grep -E '^\[  PASSED' "$tsan/tsan.log")"
+  else
+    step "tsan" 0 "skipped: needs clang++ and libomp-dev (libarcher.so)"
+  fi
+fi
+# Hook for the GUI engineer: TSan of the GUI worker/controller threads (their script, their build).
+if [[ "$skip" != *" gui-tsan "* ]] && [ -x "$root/scripts/ci-gui-tsan.sh" ]; then
+  t=$SECONDS
+  "$root/scripts/ci-gui-tsan.sh"
+  step "gui tsan (scripts/ci-gui-tsan.sh)" $((SECONDS - t)) "ok"
+fi
+
+# ---- 3. short fuzz pass ------------------------------------------------------------------------------
+if [[ "$skip" != *" fuzz "* ]]; then
+  t=$SECONDS
+  FL_JOBS="$jobs" "$root/scripts/fuzz.sh" "${FL_FUZZ_SECONDS:-25}"
+  step "fuzz (5 targets)" $((SECONDS - t)) "ok, see $FL_FUZZ_BUILD/fuzz-summary.txt"
+fi
+
+echo "== ci-reliability summary"
+printf '%s\n' "${report[@]}"
+echo "total $((SECONDS - t_start)) s"
