@@ -38,19 +38,23 @@ struct Check {
   double value, rel, abs;
 };
 
+// Tolerances are 3 standard deviations of the seed-to-seed spread of this scene, measured over 8 seeds
+// (a round-off change of the engine gives a new microstate, like a new seed): e 2.2 %, Z 2.8 %, Zm 1.1 %,
+// a_2D 0.016, G_sec 4.7 %, du 4.7 kPa, damping 0.007. A physics change beyond that spread (a wrong factor
+// in a stiffness, a lost damping term) fails.
 std::vector<Check> measures(const Runner& r) {
   const Sample& c = r.summaries().at(1).end;
   std::vector<Check> m = {
-      {"void_ratio_318kPa", c.voidRatio, 0.01, 0},
-      {"Z_318kPa", c.Z, 0.04, 0},
-      {"Zm_318kPa", c.Zm, 0.04, 0},
-      {"a_2D_318kPa", c.a2D, 0, 0.03},
+      {"void_ratio_318kPa", c.voidRatio, 0.065, 0},
+      {"Z_318kPa", c.Z, 0.085, 0},
+      {"Zm_318kPa", c.Zm, 0.035, 0},
+      {"a_2D_318kPa", c.a2D, 0, 0.05},
   };
   for (const CycleRecord& k : r.cycles()) {
     const std::string n = std::to_string(k.cycle);
-    m.push_back({"G_sec_cycle" + n, k.Gsec, 0.08, 0});
-    m.push_back({"du_end_cycle" + n, k.duEnd, 0, 0.15 * 318e3});
-    m.push_back({"damping_cycle" + n, k.damping, 0, 0.03});
+    m.push_back({"G_sec_cycle" + n, k.Gsec, 0.14, 0});
+    m.push_back({"du_end_cycle" + n, k.duEnd, 0, 14e3});
+    m.push_back({"damping_cycle" + n, k.damping, 0, 0.021});
   }
   return m;
 }

@@ -226,13 +226,15 @@ TEST_F(CrashSafety, KillAnywhereLosesNothingAndRestarts) {
   std::mt19937 rng(20240808);  // fixed: the same kill schedule on every run (the landing spots vary with load)
   std::uniform_int_distribution<int> delayMs(150, 2500);
   const fs::path results = m_root / "results";
+  const fs::path lastFinished = m_root / "results-finished";
   std::map<std::string, std::string> before;
   const auto t0 = Clock::now();
   int survived = 0, restarts = 0, fresh = 0, finished = 0, maxCheckpoints = 0;
   for (long k = 0; k < kills; ++k) {
     if (k >= 10 && std::chrono::duration<double>(Clock::now() - t0).count() > budget) break;
     // Continue from the newest checkpoint if there is one, else start (again) from the scene.
-    const fs::path ck = newestCheckpoint(results);
+    fs::path ck = newestCheckpoint(results);
+  if (ck.empty()) ck = newestCheckpoint(lastFinished);  // the last run finished before its kill
     Child c;
     if (ck.empty()) {
       c = spawnRun({m_scene.string(), "--overwrite", "--quiet"}, m_root / "run");
@@ -248,7 +250,8 @@ TEST_F(CrashSafety, KillAnywhereLosesNothingAndRestarts) {
       ASSERT_EQ(code, 0) << "run exited early with " << code << ": " << errText("run");
       ++finished;
       checkResults(results, before);
-      fs::remove_all(results);
+      fs::remove_all(lastFinished);  // keep the last finished run aside: its checkpoints restart too
+      fs::rename(results, lastFinished);
       before.clear();
       continue;
     }
@@ -264,7 +267,8 @@ TEST_F(CrashSafety, KillAnywhereLosesNothingAndRestarts) {
     ++survived;
   }
   // The newest checkpoint restarts and runs on in-process.
-  const fs::path ck = newestCheckpoint(results);
+  fs::path ck = newestCheckpoint(results);
+  if (ck.empty()) ck = newestCheckpoint(lastFinished);  // the last run finished before its kill
   ASSERT_FALSE(ck.empty()) << "no checkpoint was ever written";
   fl::Runner r = fl::Runner::fromCheckpoint(ck.string());
   const long step0 = r.simulation().stepCount();
