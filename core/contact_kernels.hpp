@@ -40,6 +40,7 @@ struct TangentialResult {
   double slipWork = 0.0;   // energy dissipated by Coulomb sliding this step [J]
   double stiffnessWork = 0.0;  // spring energy removed by the stiffness update (steps 1-2) [J], >= 0
   double stiffness = 0.0;  // k_t used [N/m]
+  double compliance = 0.0;  // 1/k_t [m/N] (0 when k_t = 0), so callers need no further division
   bool sliding = false;
 };
 
@@ -53,20 +54,31 @@ struct TangentialResult {
 // Energy: the spring stores |F_t|^2 / (2 k_t). Steps 1-2 change that at no displacement (k_t follows the
 // normal load); the change is reported as stiffnessWork and is never negative, so the law cannot create
 // energy: on unloading it is the micro-slip loss of Mindlin–Deresiewicz, on loading the stiffening spring.
+// With r = a/a_prev and F0 the stored force: |F0|^2/(2 k_t,prev) - |F1|^2/(2 k_t) = (r |F0|^2 - |F1|^2)/(2 k_t),
+// where |F1|^2 = r^2 |F0|^2 on unloading (>= 0 as 0 < r < 1) and |F0|^2 on loading (>= 0 as r >= 1).
 // History is updated in place. v_t is the tangential velocity of j's contact point relative to i's.
+// Cost: one division and one square root for the rotation, one division for a/a_prev, one for 1/k_t
+// (the energy terms only; dropped by the compiler when the caller ignores them).
 inline TangentialResult mindlinNoSlip(const Vec3& n, const Vec3& vt, double contactRadius, double normalForce,
                                       double effShear, double friction, double dt, ContactHistory& h) {
   TangentialResult r;
   const double kt = mindlinStiffness(effShear, contactRadius);
+  const double compliance = kt > 0.0 ? 1.0 / kt : 0.0;
   Vec3 ft = h.tangentialForce;
   const double old2 = ft.squaredNorm();
   if (old2 > 0.0) {
     ft -= ft.dot(n) * n;
     const double new2 = ft.squaredNorm();
     if (new2 > 0.0) ft *= std::sqrt(old2 / new2);
-    if (contactRadius < h.contactRadius) ft *= contactRadius / h.contactRadius;
-    const double ktOld = mindlinStiffness(effShear, h.contactRadius);
-    if (ktOld > 0.0 && kt > 0.0) r.stiffnessWork = old2 / (2.0 * ktOld) - ft.squaredNorm() / (2.0 * kt);
+    if (h.contactRadius > 0.0) {
+      const double ratio = contactRadius / h.contactRadius;  // k_t / k_t,prev
+      double kept2 = old2;                                    // |F_t|^2 after steps 1-2
+      if (ratio < 1.0) {
+        ft *= ratio;
+        kept2 = old2 * ratio * ratio;
+      }
+      r.stiffnessWork = (ratio * old2 - kept2) * (0.5 * compliance);
+    }
   }
   ft -= kt * dt * vt;
   const double cap = friction * normalForce;
@@ -74,7 +86,7 @@ inline TangentialResult mindlinNoSlip(const Vec3& n, const Vec3& vt, double cont
   if (f2 > cap * cap) {
     const double fmag = std::sqrt(f2);
     const Vec3 capped = (cap / fmag) * ft;
-    r.slipWork = kt > 0.0 ? cap * (fmag - cap) / kt : 0.0;
+    r.slipWork = cap * (fmag - cap) * compliance;
     ft = capped;
     r.sliding = true;
   }
@@ -82,6 +94,7 @@ inline TangentialResult mindlinNoSlip(const Vec3& n, const Vec3& vt, double cont
   h.contactRadius = contactRadius;
   r.force = ft;
   r.stiffness = kt;
+  r.compliance = compliance;
   return r;
 }
 

@@ -12,7 +12,9 @@
 namespace fl {
 
 namespace {
-constexpr std::size_t kChunk = 1024;  // fixed reduction block: results independent of thread count
+// Fixed reduction block (pairs or particles): results are independent of the thread count. Small enough
+// that 2 threads share ~60 blocks of a 4000-sphere packing evenly, large enough to amortise a block's sums.
+constexpr std::size_t kChunk = 256;
 
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
@@ -208,20 +210,32 @@ void Simulation::rebuildNeighbours() {
   m_refPos = m_p.pos;
   m_refHinv = m_cell.inverse();
   m_maxDisp2 = 0.0;
-  m_chunks.resize(std::max<std::size_t>(1, (std::max(m_c.size(), n) + kChunk - 1) / kChunk));
+  resizeChunks();
+}
+
+void Simulation::resizeChunks() {
+  m_chunks.resize(std::max<std::size_t>(1, (std::max(m_c.size(), m_p.size()) + kChunk - 1) / kChunk));
 }
 
 // ---- 3. contacts --------------------------------------------------------------------------------
 void Simulation::computeContacts() {
+  // one instantiation per combination of optional terms: no branch on a disabled feature in the loop
   const bool damping = m_num.restitution < 1.0;
-  if (m_num.trackEnergy) {
-    damping ? contactPass<true, true>() : contactPass<true, false>();
-  } else {
-    damping ? contactPass<false, true>() : contactPass<false, false>();
+  const bool affine = !m_cell.velocityGradient().isZero(0.0);
+  const int mode = (m_num.trackEnergy ? 4 : 0) | (damping ? 2 : 0) | (affine ? 1 : 0);
+  switch (mode) {
+    case 0: contactPass<false, false, false>(); break;
+    case 1: contactPass<false, false, true>(); break;
+    case 2: contactPass<false, true, false>(); break;
+    case 3: contactPass<false, true, true>(); break;
+    case 4: contactPass<true, false, false>(); break;
+    case 5: contactPass<true, false, true>(); break;
+    case 6: contactPass<true, true, false>(); break;
+    default: contactPass<true, true, true>(); break;
   }
 }
 
-template <bool kEnergy, bool kDamping>
+template <bool kEnergy, bool kDamping, bool kAffine>
 void Simulation::contactPass() {
   const std::size_t np = m_c.size();
   const std::size_t nchunks = (np + kChunk - 1) / kChunk;
@@ -234,51 +248,65 @@ void Simulation::contactPass() {
   const double* rad = m_p.radius.data();
   const double* im = m_p.invMass.data();
   const std::uint16_t* mat = m_p.material.data();
-  ContactStore& c = m_c;
+  const std::int32_t* first = m_c.first.data();
+  const std::int32_t* second = m_c.second.data();
+  const Image* image = m_c.image.data();
+  ContactHistory* hist = m_c.history.data();
+  double* overlap = m_c.overlap.data();
+  double* distance = m_c.distance.data();
+  double* normalForce = m_c.normalForce.data();
+  Vec3* normal = m_c.normal.data();
+  Vec3* force = m_c.force.data();
   const PairTable& table = m_pairs;
+  Chunk* chunks = m_chunks.data();
 #pragma omp parallel for num_threads(m_num.threads) schedule(static)
   for (std::size_t k = 0; k < nchunks; ++k) {
     Chunk acc;
     const std::size_t end = std::min(np, (k + 1) * kChunk);
     for (std::size_t p = k * kChunk; p < end; ++p) {
-      const int i = c.first[p], j = c.second[p];
+      const int i = first[p], j = second[p];
       Vec3 d = x[j] - x[i];
-      const Image img = c.image[p];
+      const Image img = image[p];
       if (!img.isZero()) d += H * img.vec().cast<double>();
-      const double R = rad[i] + rad[j];
+      const double ri = rad[i], rj = rad[j];
+      const double R = ri + rj;
       const double dist2 = d.squaredNorm();
       if (dist2 >= R * R) {
-        if (c.overlap[p] != 0.0 || c.history[p].contactRadius != 0.0) {
-          c.overlap[p] = 0.0;
-          c.normalForce[p] = 0.0;
-          c.force[p].setZero();
-          c.history[p] = ContactHistory{};
+        // not touching: results and history are zero (the kick gathers the zero force unconditionally)
+        if (overlap[p] != 0.0 || hist[p].contactRadius != 0.0) {
+          overlap[p] = 0.0;
+          normalForce[p] = 0.0;
+          force[p].setZero();
+          hist[p] = ContactHistory{};
         }
         continue;
       }
       const double dist = std::sqrt(dist2);
-      const Vec3 n = d / dist;
+      const double invDist = 1.0 / dist;
+      const Vec3 n = d * invDist;
       const double delta = R - dist;
-      const double li = rad[i] - 0.5 * delta, lj = rad[j] - 0.5 * delta;
+      const double li = ri - 0.5 * delta, lj = rj - 0.5 * delta;
       // relative velocity of j's contact point w.r.t. i's, including the mean field L·l, which carries the
       // image shift velocity L·H·n for pairs across the boundary (verification ladder §2)
-      const Vec3 vrel = v[j] - v[i] + L * d - (lj * w[j] + li * w[i]).cross(n);
+      Vec3 vrel = v[j] - v[i] - (lj * w[j] + li * w[i]).cross(n);
+      if constexpr (kAffine) vrel += L * d;
       const double vn = vrel.dot(n);
       const Vec3 vt = vrel - vn * n;
       const PairParams& pp = table(mat[i], mat[j]);
-      const double Rstar = rad[i] * rad[j] / R;
-      const double mstar = 1.0 / (im[i] + im[j]);
+      const double Rstar = ri * rj / R;
       const double a = std::sqrt(Rstar * delta);
       const double fe = kernels::hertzForce(pp.effYoung, a, delta);
       double fn = fe;
       const double kn = kernels::hertzStiffness(pp.effYoung, a);
       double dampPower = 0.0;
+      double mstar = 0.0;
       if constexpr (kDamping) {
+        mstar = 1.0 / (im[i] + im[j]);
         const double cn = kernels::dampingCoefficient(pp.dampingRatio, kn, mstar);
         fn = std::max(0.0, fe - cn * vn);  // no attraction
         dampPower += (fe - fn) * vn;       // = cn vn^2 unless clamped
       }
-      auto tr = kernels::mindlinNoSlip(n, vt, a, fn, pp.effShear, pp.friction, dt, c.history[p]);
+      auto tr = kernels::mindlinNoSlip(n, vt, a, fn, pp.effShear, pp.friction, dt, hist[p]);
       Vec3 ft = tr.force;
       if constexpr (kDamping) {
         if (!tr.sliding) {
@@ -288,26 +316,26 @@ void Simulation::contactPass() {
         }
       }
       const Vec3 f = fn * n + ft;
-      c.overlap[p] = delta;
-      c.distance[p] = dist;
-      c.normal[p] = n;
-      c.normalForce[p] = fn;
-      c.force[p] = f;
-      acc.stress += f * d.transpose();
+      overlap[p] = delta;
+      distance[p] = dist;
+      normal[p] = n;
+      normalForce[p] = fn;
+      force[p] = f;
+      acc.stress.noalias() += f * d.transpose();
       acc.stiffness += kn * n.cwiseProduct(d).cwiseAbs2();
       acc.sumForce += f.norm();
       ++acc.contacts;
       acc.sliding += tr.sliding;
-      acc.maxOverlapRatio = std::max(acc.maxOverlapRatio, delta / std::min(rad[i], rad[j]));
+      acc.maxOverlapRatio = std::max(acc.maxOverlapRatio, delta / std::min(ri, rj));
       acc.maxKOverM = std::max(acc.maxKOverM, std::max(kn, 3.5 * tr.stiffness) * (im[i] + im[j]));
       if constexpr (kEnergy) {
         acc.elasticN += kernels::hertzEnergy(fe, delta);
-        if (tr.stiffness > 0.0) acc.elasticT += tr.force.squaredNorm() / (2.0 * tr.stiffness);
+        acc.elasticT += tr.force.squaredNorm() * (0.5 * tr.compliance);
         acc.friction += tr.slipWork + tr.stiffnessWork;
         acc.damping += dampPower * dt;
       }
     }
-    m_chunks[k] = acc;
+    chunks[k] = acc;
   }
   // ordered reduction
   Mat3 s = Mat3::Zero();
@@ -355,7 +383,11 @@ void Simulation::kickPass() {
   const std::size_t nchunks = (static_cast<std::size_t>(n) + kChunk - 1) / kChunk;
   const double h = 0.5 * m_dt;
   const double alpha = m_num.localDamping;
-  const ContactStore& c = m_c;
+  const std::int32_t* adjStart = m_c.adjStart.data();
+  const std::int32_t* adjEntry = m_c.adjEntry.data();
+  const Vec3* force = m_c.force.data();
+  const Vec3* normal = m_c.normal.data();
+  const double* overlap = m_c.overlap.data();
   const double* rad = m_p.radius.data();
   Vec3* F = m_p.force.data();
   Vec3* T = m_p.torque.data();
@@ -369,16 +401,19 @@ void Simulation::kickPass() {
     const int end = static_cast<int>(std::min<std::size_t>(n, (k + 1) * kChunk));
     for (int i = static_cast<int>(k * kChunk); i < end; ++i) {
       Vec3 f = Vec3::Zero(), t = Vec3::Zero();
-      for (int e = c.adjStart[i]; e < c.adjStart[i + 1]; ++e) {
-        const int entry = c.adjEntry[e];
+      // Pairs that do not touch hold a zero force (the contact pass keeps it so), so they are gathered
+      // without a branch: adding zero changes nothing but the sign of a zero.
+      const double ri = rad[i];
+      for (int e = adjStart[i]; e < adjStart[i + 1]; ++e) {
+        const int entry = adjEntry[e];
         const int p = entry >> 1;
-        if (c.overlap[p] <= 0.0) continue;
-        const Vec3& fp = c.force[p];
+        const Vec3 fp = force[p];
         // torque = -(r_self - delta/2) n x f on both particles (contact point on the pair axis)
-        const double lever = rad[i] - 0.5 * c.overlap[p];
-        t -= lever * c.normal[p].cross(fp);
-        if (entry & 1) f += fp;
-        else f -= fp;
+        const double lever = ri - 0.5 * overlap[p];
+        t -= lever * normal[p].cross(fp);
+        // side 1 (second particle) receives +f, side 0 receives -f
+        const double sign = static_cast<double>(((entry & 1) << 1) - 1);
+        f += sign * fp;
       }
       F[i] = f;
       T[i] = t;

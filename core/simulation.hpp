@@ -124,9 +124,10 @@ class Simulation {
   void drift();
   bool needsRebuild() const;
   void rebuildNeighbours();
+  void resizeChunks();  // m_chunks for the current pair and particle counts
   void computeContacts();
   Simulation() = default;  // for restoreState
-  template <bool kEnergy, bool kDamping>
+  template <bool kEnergy, bool kDamping, bool kAffine>
   void contactPass();
   void kick();
   template <bool kLocalDamping>

@@ -1,6 +1,8 @@
 // Bit-exact save/restore of a Simulation (verification ladder §5: save at step N, reload, run k steps:
 // identical to an unbroken run). Everything the next step reads is saved, including the neighbour-list
 // reference positions and the previous stress used by the boundary-work integral.
+#include <cstring>
+
 #include "binary_io.hpp"
 #include "simulation.hpp"
 
@@ -93,6 +95,11 @@ Simulation Simulation::restoreState(BinaryReader& r) {
     s.m_materials.push_back(m);
   }
   s.m_num = r.get<NumericsSettings>("numerics");
+  {  // inspect the flag's byte without loading it as a bool (a corrupted byte would be UB)
+    unsigned char b;
+    std::memcpy(&b, &s.m_num.trackEnergy, 1);
+    if (b > 1) r.fail("invalid numerics.trackEnergy flag");
+  }
   try {
     s.m_num.validate();
   } catch (const InputError& e) {
@@ -158,7 +165,7 @@ Simulation Simulation::restoreState(BinaryReader& r) {
   if (!(s.m_dt > 0.0)) r.fail("time step must be > 0");
   // friction may have been changed during the run: the materials carry the current value
   s.m_pairs = PairTable(s.m_materials, s.m_num.restitution);
-  s.m_chunks.resize(std::max<std::size_t>(1, (std::max(np, n) + 1023) / 1024));
+  s.resizeChunks();
   return s;
 }
 

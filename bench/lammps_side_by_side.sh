@@ -1,0 +1,134 @@
+#!/usr/bin/env bash
+# FabricLab vs LAMMPS on the same dense packing, in one invocation (issue 6).
+#
+#   bench/lammps_side_by_side.sh [--steps N] [--repeats N] [--build DIR] [--out DIR]
+#
+# 1. installs Debian's `lammps` if missing (idempotent; never yade or paraview: they remove libvtk9-dev),
+# 2. builds bench_dense (cmake, no GUI) in --build (default build/perf) unless it is already built,
+# 3. bench_dense prepares or loads the cached 4000-sphere packing at p' = 318 kPa, exports it as a LAMMPS
+#    data file (core/packing_io.hpp writeLammpsData) and measures FabricLab at 1 and 2 threads,
+# 4. runs LAMMPS on that data file with the same physics — Hertz with E* from E and nu
+#    (hertz/material), Mindlin no-slip tangential spring k_t = 8 G* a (tangential mindlin NULL), Coulomb
+#    mu = 0.235, no damping (eta_n0 = 0, x_gamma_t = 0), no rolling or twisting, newton on,
+#    fix nve/sphere, same dt, same steps, same skin — at 1 and 2 MPI ranks,
+# 5. checks that both see the same p and coordination number Z = 2C/N at step 0 (fails beyond 1 %),
+# 6. prints particle-steps/s for each and the ratio FabricLab / LAMMPS.
+# Timings are medians of --repeats runs; LAMMPS's is its "Loop time" (the run only, no setup).
+set -euo pipefail
+
+steps=20000
+repeats=5
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build="$root/build/perf"
+out="$root/build/bench-cache"
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --steps) steps="$2"; shift 2 ;;
+    --repeats) repeats="$2"; shift 2 ;;
+    --build) build="$2"; shift 2 ;;
+    --out) out="$2"; shift 2 ;;
+    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
+    *) echo "lammps_side_by_side: unknown option $1" >&2; exit 2 ;;
+  esac
+done
+
+die() { echo "lammps_side_by_side: FAIL: $*" >&2; exit 1; }
+
+# ---- 1. LAMMPS --------------------------------------------------------------------------------------
+if ! dpkg -s lammps >/dev/null 2>&1 || ! command -v lmp >/dev/null 2>&1; then
+  sudo=""
+  [[ $(id -u) -ne 0 ]] && sudo="sudo"
+  echo "installing Debian's lammps ..."
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y --no-install-recommends lammps openmpi-bin >/dev/null
+fi
+command -v mpirun >/dev/null || die "mpirun not found (Debian package openmpi-bin)"
+lmp_version="$(dpkg -s lammps | sed -n 's/^Version: //p')"
+
+# ---- 2. FabricLab -----------------------------------------------------------------------------------
+bench="$build/bench/bench_dense"
+if [[ ! -x "$bench" ]]; then
+  cmake -S "$root" -B "$build" -DFL_BUILD_GUI=OFF -DFL_BUILD_TESTS=OFF -DCMAKE_BUILD_TYPE=Release >/dev/null
+  cmake --build "$build" -j2 --target bench_dense >/dev/null
+fi
+mkdir -p "$out"
+data="$out/dense4000_318kPa.data"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+
+echo "== FabricLab ($bench) =="
+"$bench" --cache "$out/dense4000_318kPa.state" --export-lammps "$data" --steps "$steps" --repeats "$repeats" \
+  --threads 1,2 | tee "$work/fabriclab.txt"
+export_line="$(grep '^export:' "$work/fabriclab.txt")" || die "bench_dense printed no export line"
+field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" <<<"$export_line"; }
+N="$(field N)"; E="$(field E)"; nu="$(field nu)"; mu="$(field mu)"; skin="$(field skin)"; dt="$(field dt)"
+fl_p0="$(field p0)"; fl_z0="$(field Z0)"
+fl_rate1="$(sed -n 's/^result: threads=1 rate=//p' "$work/fabriclab.txt")"
+fl_rate2="$(sed -n 's/^result: threads=2 rate=//p' "$work/fabriclab.txt")"
+
+# ---- 4. LAMMPS --------------------------------------------------------------------------------------
+cat >"$work/in.dense" <<EOF
+# FabricLab benchmark scene: Hertz-Mindlin glass beads, no damping, dt = $dt s
+units           si
+atom_style      sphere
+boundary        p p p
+newton          on
+comm_modify     vel yes
+read_data       $data
+neighbor        $skin bin
+neigh_modify    delay 0 every 1 check yes
+# hertz/material E eta_n0 nu: eta_n0 = 0 -> no normal damping; mindlin NULL -> k_t = 8 G* a from E, nu;
+# x_gamma_t = 0 -> no tangential damping; Coulomb mu
+pair_style      granular
+pair_coeff      * * hertz/material $E 0.0 $nu tangential mindlin NULL 0.0 $mu damping viscoelastic
+fix             integrate all nve/sphere
+timestep        $dt
+compute         zc all contact/atom
+compute         zsum all reduce sum c_zc
+compute         pv all pressure NULL virial
+variable        Z equal c_zsum/atoms
+thermo_style    custom step c_pv v_Z
+thermo_modify   format float %.10g
+run             0
+print           "STEP0 p=\$(c_pv:%.12g) Z=\$(v_Z:%.12g)"
+run             $steps
+print           "END p=\$(c_pv:%.12g) Z=\$(v_Z:%.12g)"
+EOF
+
+median() { sort -g | awk '{a[NR]=$1} END {if (NR%2) print a[(NR+1)/2]; else print (a[NR/2]+a[NR/2+1])/2}'; }
+lammps_rate() {  # ranks -> median particle-steps/s over the repeats
+  local ranks="$1" k loop
+  for ((k = 0; k < repeats; ++k)); do
+    mpirun --allow-run-as-root --oversubscribe -np "$ranks" lmp -in "$work/in.dense" -log none -screen "$work/lmp$ranks.txt" \
+      >/dev/null 2>&1 || { cat "$work/lmp$ranks.txt" >&2; die "LAMMPS failed on $ranks rank(s)"; }
+    loop="$(awk '/^Loop time of/ {t=$4} END {print t}' "$work/lmp$ranks.txt")"
+    awk -v n="$N" -v s="$steps" -v t="$loop" 'BEGIN {printf "%.6e\n", n * s / t}'
+  done | median
+}
+echo
+echo "== LAMMPS $lmp_version =="
+lmp_rate1="$(lammps_rate 1)"
+cp "$work/lmp1.txt" "$out/lammps_1rank.log"
+lmp_rate2="$(lammps_rate 2)"
+cp "$work/lmp2.txt" "$out/lammps_2ranks.log"
+lmp_p0="$(sed -n 's/^STEP0 p=\([^ ]*\) .*/\1/p' "$work/lmp1.txt")"
+lmp_z0="$(sed -n 's/^STEP0 .* Z=\(.*\)/\1/p' "$work/lmp1.txt")"
+lmp_end="$(grep '^END' "$work/lmp1.txt")"
+echo "LAMMPS after $steps steps (1 rank): $lmp_end"
+
+# ---- 5. same scene? ---------------------------------------------------------------------------------
+echo
+printf "step 0          %16s %16s\n" "FabricLab" "LAMMPS"
+printf "  p [Pa]        %16.6f %16.6f\n" "$fl_p0" "$lmp_p0"
+printf "  Z = 2C/N      %16.6f %16.6f\n" "$fl_z0" "$lmp_z0"
+awk -v a="$fl_p0" -v b="$lmp_p0" -v c="$fl_z0" -v d="$lmp_z0" 'BEGIN {
+  dp = (a - b) / b; if (dp < 0) dp = -dp; dz = (c - d) / d; if (dz < 0) dz = -dz;
+  printf "  relative difference: p %.2e, Z %.2e\n", dp, dz; exit !(dp <= 0.01 && dz <= 0.01) }' ||
+  die "FabricLab and LAMMPS disagree by more than 1 % at step 0: not the same scene"
+
+# ---- 6. the numbers ---------------------------------------------------------------------------------
+echo
+printf "%-22s %16s %16s %8s\n" "particle-steps/s" "FabricLab" "LAMMPS" "ratio"
+awk -v a="$fl_rate1" -v b="$lmp_rate1" 'BEGIN {printf "%-22s %16.4e %16.4e %8.2f\n", "1 thread / 1 rank", a, b, a / b}'
+awk -v a="$fl_rate2" -v b="$lmp_rate2" 'BEGIN {printf "%-22s %16.4e %16.4e %8.2f\n", "2 threads / 2 ranks", a, b, a / b}'
+echo "(N = $N, $steps steps, median of $repeats; logs in $out)"
