@@ -226,3 +226,26 @@ TEST(RunnerSpecimen, AStageCanStartFromAnotherRunsCheckpoint) {
   EXPECT_NEAR(b.summaries()[0].end.stress.z() / 100000, 1.0, 2e-3);
   fs::remove_all(dir);
 }
+
+TEST(RunnerOutputs, ParaViewSnapshotsOnTheirOwnSchedule) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("fl-runner-vtk-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  json j = smallScene();
+  j["output"]["directory"] = dir.string();
+  j["output"]["vtk_interval"] = 5000;
+  Runner r = run(j);
+  const long expected = r.simulation().stepCount() / 5000;
+  ASSERT_GT(expected, 0);
+  long vtu = 0;
+  for (const auto& e : fs::directory_iterator(dir / "paraview")) vtu += e.path().extension() == ".vtu";
+  EXPECT_EQ(vtu, 3 * expected);  // particles, contacts and cell per snapshot
+  for (const char* series : {"particles.pvd", "contacts.pvd", "cell.pvd"}) {
+    std::ifstream in(dir / "paraview" / series);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    long entries = 0;
+    for (std::size_t p = text.find("<DataSet"); p != std::string::npos; p = text.find("<DataSet", p + 1)) ++entries;
+    EXPECT_EQ(entries, expected) << series;
+  }
+  fs::remove_all(dir);
+}
