@@ -6,6 +6,7 @@
 #include "core/gas_generator.hpp"
 #include "core/rng.hpp"
 #include "core/simulation.hpp"
+#include "test_support.hpp"
 
 using namespace fl;
 
@@ -29,10 +30,6 @@ Simulation compressed(int threads) {
   return sim;
 }
 
-template <class T>
-bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
-}
 }  // namespace
 
 TEST(Determinism, OneAndTwoThreadsGiveIdenticalBits) {
@@ -41,10 +38,10 @@ TEST(Determinism, OneAndTwoThreadsGiveIdenticalBits) {
   b.run(4000);
   ASSERT_GT(a.contacts().activeCount(), 1000u) << "the test must exercise many contacts";
   ASSERT_GT(a.profile().rebuilds, 2);
-  EXPECT_TRUE(sameBits(a.particles().pos, b.particles().pos));
-  EXPECT_TRUE(sameBits(a.particles().vel, b.particles().vel));
-  EXPECT_TRUE(sameBits(a.particles().angVel, b.particles().angVel));
-  EXPECT_TRUE(sameBits(a.contacts().history, b.contacts().history));
+  EXPECT_TRUE(test::sameBits(a.particles().pos, b.particles().pos));
+  EXPECT_TRUE(test::sameBits(a.particles().vel, b.particles().vel));
+  EXPECT_TRUE(test::sameBits(a.particles().angVel, b.particles().angVel));
+  EXPECT_TRUE(test::sameBits(a.contacts().history, b.contacts().history));
   EXPECT_EQ(std::memcmp(a.contactStress().data(), b.contactStress().data(), sizeof(Mat3)), 0);
   EXPECT_EQ(a.energy().frictionWork, b.energy().frictionWork);
 }

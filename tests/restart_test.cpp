@@ -8,15 +8,9 @@
 #include "core/gas_generator.hpp"
 #include "core/rng.hpp"
 #include "core/simulation.hpp"
+#include "test_support.hpp"
 
 using namespace fl;
-
-namespace {
-template <class T>
-bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
-}
-}  // namespace
 
 TEST(Restart, SaveReloadRunIsBitIdenticalToAnUnbrokenRun) {
   GasSpec g;
@@ -44,10 +38,10 @@ TEST(Restart, SaveReloadRunIsBitIdenticalToAnUnbrokenRun) {
   b.run(2000);
   ASSERT_GT(a.contacts().activeCount(), 500u);
   ASSERT_GT(a.profile().rebuilds, 0);
-  EXPECT_TRUE(sameBits(a.particles().pos, b.particles().pos));
-  EXPECT_TRUE(sameBits(a.particles().vel, b.particles().vel));
-  EXPECT_TRUE(sameBits(a.particles().angVel, b.particles().angVel));
-  EXPECT_TRUE(sameBits(a.contacts().history, b.contacts().history));
+  EXPECT_TRUE(test::sameBits(a.particles().pos, b.particles().pos));
+  EXPECT_TRUE(test::sameBits(a.particles().vel, b.particles().vel));
+  EXPECT_TRUE(test::sameBits(a.particles().angVel, b.particles().angVel));
+  EXPECT_TRUE(test::sameBits(a.contacts().history, b.contacts().history));
   EXPECT_EQ(std::memcmp(a.cell().matrix().data(), b.cell().matrix().data(), sizeof(Mat3)), 0);
   EXPECT_EQ(a.energy().balance(), b.energy().balance());
   EXPECT_EQ(b.materials()[0].friction, 0.1);

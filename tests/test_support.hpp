@@ -1,6 +1,9 @@
 // Small builders shared by the core tests.
 #pragma once
 
+#include <cstring>
+#include <vector>
+
 #include "core/simulation.hpp"
 
 namespace fl::test {
@@ -25,6 +28,12 @@ inline Vec3 momentum(const ParticleStore& p) {
   Vec3 s = Vec3::Zero();
   for (std::size_t i = 0; i < p.size(); ++i) s += p.vel[i] / p.invMass[i];
   return s;
+}
+
+// True when both arrays hold the same bits (determinism and restart tests compare states bit for bit).
+template <class T>
+bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
 }
 
 }  // namespace fl::test
