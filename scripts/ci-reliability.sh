@@ -62,7 +62,7 @@ if [[ "$skip" != *" tsan "* ]]; then
     # grid) plus restart; 2 threads on this 2-core machine.
     filter="Determinism.*:NeighbourSearch.*:Restart.*:Conservation.LinearMomentumToRoundOff:RunnerCheckpoint.*"
     OMP_NUM_THREADS=2 OMP_TOOL_LIBRARIES="$archer" ARCHER_OPTIONS="verbose=0" \
-      TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1" \
+      TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$root/tests/tsan.supp" \
       "$tsan/tests/core_tests" --gtest_filter="$filter" >"$tsan/tsan.log" 2>&1 \
       || { grep -E "WARNING: ThreadSanitizer|FAILED|#[0-9]+ " "$tsan/tsan.log" | head -40; exit 1; }
     step "tsan build (clang, libomp)" "$b" "ok"
