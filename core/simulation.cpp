@@ -141,7 +141,6 @@ void Simulation::drift() {
   const double* ii = m_p.invInertia.data();
   const Vec3* x0 = m_refPos.data();
   double maxd2 = 0.0;
-  double localWork = 0.0;
 #pragma omp parallel for num_threads(m_num.threads) schedule(static) reduction(max : maxd2)
   for (int i = 0; i < n; ++i) {
     Vec3 f = F[i], t = T[i];
@@ -158,7 +157,6 @@ void Simulation::drift() {
     maxd2 = std::max(maxd2, u.squaredNorm());
   }
   m_maxDisp2 = maxd2;
-  (void)localWork;
 }
 
 // ---- 2. neighbours ------------------------------------------------------------------------------
