@@ -249,3 +249,15 @@ TEST(RunnerOutputs, ParaViewSnapshotsOnTheirOwnSchedule) {
   }
   fs::remove_all(dir);
 }
+
+TEST(RunnerStages, K0LoadingToAMeanStressTarget) {
+  // the paper's K0 consolidation "up to p' = 318 kPa": the axial servo drives p', lateral strain stays 0
+  json j = smallScene();
+  j["stages"].push_back({{"type", "k0"}, {"pressure", 150000}});
+  Runner r = run(j);
+  const StageSummary& k0 = r.summaries().back();
+  EXPECT_NEAR(k0.end.p / 150000, 1.0, 2e-3);
+  EXPECT_EQ(k0.end.epsR, 0.0);
+  EXPECT_GT(k0.end.q, 0.0);  // vertical stress above the lateral one
+  EXPECT_LT(k0.K0, 1.0);
+}
