@@ -29,12 +29,29 @@ struct ContactHistory {
   double contactRadius = 0.0;           // a = sqrt(R* delta) of the previous step [m]
 };
 
+// Branch of the Mindlin–Deresiewicz (1953) tangential law, with Thornton's (1991) names.
+enum class MdBranch : std::int32_t { Loading = 0, Unloading = 1, Reloading = 2 };
+
+// Extra history of the Mindlin–Deresiewicz tangential law (core/mindlin_deresiewicz.hpp), kept in its own
+// array (ContactStore::mdHistory) that exists only when that law is selected, so the default law's
+// per-pair data and loop are unchanged. Vectors live in the tangent plane and are rotated with F_t.
+struct MdHistory {
+  Vec3 turnLoad = Vec3::Zero();    // T*: F_t where the last loading/reloading branch reversed [N]
+  Vec3 turnUnload = Vec3::Zero();  // T**: F_t where the last unloading branch reversed [N]
+  Vec3 direction = Vec3::Zero();   // unit direction of the last tangential displacement increment [-]
+  double prevNormalForce = 0.0;    // N of the previous step [N]
+  double locked = 0.0;             // micro-slip energy locked in the contact (ledger: stored) [J], >= 0
+  MdBranch branch = MdBranch::Loading;
+  std::int32_t pad = 0;            // explicit, so checkpoints hold no indeterminate bytes
+};
+
 struct ContactStore {
   // pair definition (rebuilt with the neighbour list)
   std::vector<std::int32_t> first, second;  // particle indices i < j
   std::vector<Image> image;                  // shift applied to j
   // history (carried over across rebuilds by key)
   std::vector<ContactHistory> history;
+  std::vector<MdHistory> mdHistory;  // same length as history with the Mindlin–Deresiewicz law, else empty
   // results of the last force pass
   std::vector<Vec3> normal;     // unit n from i to j (valid when overlap > 0)
   std::vector<double> overlap;  // delta [m]; <= 0: not touching

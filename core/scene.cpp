@@ -116,6 +116,10 @@ std::vector<SchemaField> makeSchema() {
   s.push_back(num("numerics", "skin", "m", "0", 0, 1, false, false, "Verlet skin; 0 = 0.1 x mean diameter."));
   s.push_back(integer("numerics", "threads", "0", 0, 1024, "OpenMP threads; 0 = all cores. Results do not depend on it."));
   s.push_back(boolean("numerics", "track_energy", "true", "Accumulate the energy ledger every step."));
+  s.push_back(choice("numerics", "tangential_model", tangentialModelName(TangentialModel::MindlinNoSlip),
+                     tangentialModelNames(),
+                     "Tangential contact law: mindlin_no_slip (k_t = 8 G* a, Coulomb cap) or mindlin_deresiewicz "
+                     "(micro-slip, Thornton's loading/unloading/reloading rules); see docs/contact-laws.md."));
   // servo
   s.push_back(num("servo", "gain", "-", "0.2", 0, 1, true, false, "Fraction of the stress error corrected per step."));
   s.push_back(num("servo", "max_strain_rate", "1/s", "1", 0, 1e6, true, false, "Cap on servo strain rates."));
@@ -343,6 +347,13 @@ Scene parseScene(const json& j, const std::string& file, const std::string& base
   s.numerics.skin = nu.at("skin");
   s.numerics.threads = nu.at("threads").get<int>();
   s.numerics.trackEnergy = nu.at("track_energy");
+  {  // the schema has checked the name against the same table
+    const auto model = tangentialModelFromName(nu.at("tangential_model").get<std::string>());
+    if (!model)
+      throw InputError(file + ": numerics.tangential_model = " + nu.at("tangential_model").dump() +
+                       " is not allowed; expected one of {" + tangentialModelList() + "}");
+    s.numerics.tangentialModel = *model;
+  }
   const json sv = section("servo");
   s.servo.gain = sv.at("gain");
   s.servo.maxStrainRate = sv.at("max_strain_rate");
@@ -485,7 +496,8 @@ std::string sceneToJson(const Scene& s) {
   j["numerics"] = {{"time_step_factor", s.numerics.timeStepFactor}, {"time_step", s.numerics.timeStep},
                    {"local_damping", s.numerics.localDamping},     {"restitution", s.numerics.restitution},
                    {"density_scale", s.numerics.densityScale},     {"skin", s.numerics.skin},
-                   {"threads", s.numerics.threads},                {"track_energy", s.numerics.trackEnergy}};
+                   {"threads", s.numerics.threads},                {"track_energy", s.numerics.trackEnergy},
+                   {"tangential_model", tangentialModelName(s.numerics.tangentialModel)}};
   j["servo"] = {{"gain", s.servo.gain},
                 {"max_strain_rate", s.servo.maxStrainRate},
                 {"max_inertial_number", s.maxInertialNumber},

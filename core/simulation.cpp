@@ -7,6 +7,7 @@
 
 #include "contact_kernels.hpp"
 #include "errors.hpp"
+#include "mindlin_deresiewicz.hpp"
 #include "neighbor_search.hpp"
 
 namespace fl {
@@ -41,6 +42,9 @@ Simulation::Simulation(ParticleStore particles, PeriodicCell cell, std::vector<M
                        NumericsSettings numerics)
     : m_p(std::move(particles)), m_cell(std::move(cell)), m_materials(std::move(materials)), m_num(numerics) {
   m_num.validate();
+  if (!isTangentialModel(m_num.tangentialModel))
+    throw InputError("numerics.tangential_model: unknown value " +
+                     std::to_string(static_cast<int>(m_num.tangentialModel)) + "; allowed: " + tangentialModelList());
   if (m_materials.empty()) throw InputError("simulation: at least one material is required");
   if (m_p.size() < 1) throw InputError("simulation: no particles");
   for (std::size_t i = 0; i < m_p.size(); ++i)
@@ -189,6 +193,8 @@ void Simulation::rebuildNeighbours() {
   next.second = std::move(L.second);
   next.image = std::move(L.image);
   next.history.assign(next.size(), ContactHistory{});
+  const bool md = m_num.tangentialModel == TangentialModel::MindlinDeresiewicz;
+  if (md) next.mdHistory.assign(next.size(), MdHistory{});
   // carry history over by key: both lists are sorted by (i, j)
   std::size_t q = 0;
   for (std::size_t p = 0; p < next.size() && q < old.size(); ++p) {
@@ -198,6 +204,7 @@ void Simulation::rebuildNeighbours() {
       const Vec3i key = next.image[p].vec() - m_p.image[j] + m_p.image[i];
       if (key == old[r].key) {
         next.history[p] = m_c.history[old[r].index];
+        if (md) next.mdHistory[p] = m_c.mdHistory[old[r].index];
         break;
       }
     }
@@ -217,23 +224,43 @@ void Simulation::resizeChunks() {
 
 // ---- 3. contacts --------------------------------------------------------------------------------
 void Simulation::computeContacts() {
+  // the tangential law is chosen once per pass, not per pair
+  if (m_num.tangentialModel == TangentialModel::MindlinDeresiewicz) dispatchContactPass<true>();
+  else dispatchContactPass<false>();
+}
+
+template <bool kMD>
+void Simulation::dispatchContactPass() {
   // one instantiation per combination of optional terms: no branch on a disabled feature in the loop
   const bool damping = m_num.restitution < 1.0;
   const bool affine = !m_cell.velocityGradient().isZero(0.0);
   const int mode = (m_num.trackEnergy ? 4 : 0) | (damping ? 2 : 0) | (affine ? 1 : 0);
   switch (mode) {
-    case 0: contactPass<false, false, false>(); break;
-    case 1: contactPass<false, false, true>(); break;
-    case 2: contactPass<false, true, false>(); break;
-    case 3: contactPass<false, true, true>(); break;
-    case 4: contactPass<true, false, false>(); break;
-    case 5: contactPass<true, false, true>(); break;
-    case 6: contactPass<true, true, false>(); break;
-    default: contactPass<true, true, true>(); break;
+    case 0: contactPass<false, false, false, kMD>(); break;
+    case 1: contactPass<false, false, true, kMD>(); break;
+    case 2: contactPass<false, true, false, kMD>(); break;
+    case 3: contactPass<false, true, true, kMD>(); break;
+    case 4: contactPass<true, false, false, kMD>(); break;
+    case 5: contactPass<true, false, true, kMD>(); break;
+    case 6: contactPass<true, true, false, kMD>(); break;
+    default: contactPass<true, true, true, kMD>(); break;
   }
 }
 
-template <bool kEnergy, bool kDamping, bool kAffine>
+void Simulation::syncTangentialHistory() {
+  if (m_num.tangentialModel != TangentialModel::MindlinDeresiewicz) {
+    // leaving the law: its locked micro-slip energy is dissipated (the ledger stays balanced)
+    if (m_num.trackEnergy)
+      for (const MdHistory& h : m_c.mdHistory) m_energy.frictionWork += h.locked;
+    m_c.mdHistory.clear();
+    m_c.mdHistory.shrink_to_fit();
+  } else if (m_c.mdHistory.size() != m_c.size()) {
+    m_c.mdHistory.assign(m_c.size(), MdHistory{});
+    for (std::size_t p = 0; p < m_c.size(); ++p) m_c.mdHistory[p].prevNormalForce = m_c.normalForce[p];
+  }
+}
+
+template <bool kEnergy, bool kDamping, bool kAffine, bool kMindlinDeresiewicz>
 void Simulation::contactPass() {
   const std::size_t np = m_c.size();
   const std::size_t nchunks = (np + kChunk - 1) / kChunk;
@@ -250,6 +277,7 @@ void Simulation::contactPass() {
   const std::int32_t* second = m_c.second.data();
   const Image* image = m_c.image.data();
   ContactHistory* hist = m_c.history.data();
+  MdHistory* mdHist = m_c.mdHistory.data();  // null unless kMindlinDeresiewicz
   double* overlap = m_c.overlap.data();
   double* distance = m_c.distance.data();
   double* normalForce = m_c.normalForce.data();
@@ -276,6 +304,11 @@ void Simulation::contactPass() {
           normalForce[p] = 0.0;
           force[p].setZero();
           hist[p] = ContactHistory{};
+          if constexpr (kMindlinDeresiewicz) {
+            // the contact opened: its locked micro-slip energy is dissipated
+            if constexpr (kEnergy) acc.friction += mdHist[p].locked;
+            mdHist[p] = MdHistory{};
+          }
         }
         continue;
       }
@@ -304,11 +337,29 @@ void Simulation::contactPass() {
         fn = std::max(0.0, fe - cn * vn);  // no attraction
         dampPower += (fe - fn) * vn;       // = cn vn^2 unless clamped
       }
-      auto tr = kernels::mindlinNoSlip(n, vt, a, fn, pp.effShear, pp.friction, dt, hist[p]);
-      Vec3 ft = tr.force;
+      // tangential law: elastic force, stiffness k_t (time step, damping), stored energy and dissipation
+      Vec3 ftElastic;
+      double kt, storedT, dissipatedT;
+      bool sliding;
+      if constexpr (kMindlinDeresiewicz) {
+        const auto tr = kernels::mindlinDeresiewicz(n, vt, a, fn, pp.effShear, pp.friction, dt, hist[p], mdHist[p]);
+        ftElastic = tr.force;
+        kt = tr.stiffness;
+        sliding = tr.sliding;
+        storedT = tr.storedEnergy;
+        dissipatedT = tr.slipWork + tr.microSlipWork;
+      } else {
+        const auto tr = kernels::mindlinNoSlip(n, vt, a, fn, pp.effShear, pp.friction, dt, hist[p]);
+        ftElastic = tr.force;
+        kt = tr.stiffness;
+        sliding = tr.sliding;
+        storedT = tr.force.squaredNorm() * (0.5 * tr.compliance);
+        dissipatedT = tr.slipWork + tr.stiffnessWork;
+      }
+      Vec3 ft = ftElastic;
       if constexpr (kDamping) {
-        if (!tr.sliding) {
-          const Vec3 fd = -kernels::dampingCoefficient(pp.dampingRatio, tr.stiffness, mstar) * vt;
+        if (!sliding) {
+          const Vec3 fd = -kernels::dampingCoefficient(pp.dampingRatio, kt, mstar) * vt;
           ft += fd;
           dampPower -= fd.dot(vt);
         }
@@ -323,13 +374,13 @@ void Simulation::contactPass() {
       acc.stiffness += kn * n.cwiseProduct(d).cwiseAbs2();
       acc.sumForce += f.norm();
       ++acc.contacts;
-      acc.sliding += tr.sliding;
+      acc.sliding += sliding;
       acc.maxOverlapRatio = std::max(acc.maxOverlapRatio, delta / std::min(ri, rj));
-      acc.maxKOverM = std::max(acc.maxKOverM, std::max(kn, 3.5 * tr.stiffness) * (im[i] + im[j]));
+      acc.maxKOverM = std::max(acc.maxKOverM, std::max(kn, 3.5 * kt) * (im[i] + im[j]));
       if constexpr (kEnergy) {
         acc.elasticN += kernels::hertzEnergy(fe, delta);
-        acc.elasticT += tr.force.squaredNorm() * (0.5 * tr.compliance);
-        acc.friction += tr.slipWork + tr.stiffnessWork;
+        acc.elasticT += storedT;
+        acc.friction += dissipatedT;
         acc.damping += dampPower * dt;
       }
     }

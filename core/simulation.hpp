@@ -4,7 +4,8 @@
 //   1. drift      half kick v += dt/2 a, x = Phi x + dt v', cell H = Phi H (Phi = exp(L dt))
 //   2. neighbours rebuild the Verlet list when a displacement or the cell strain may exceed the skin
 //   3. contacts   Hertz–Mindlin forces for every pair, written into the contact store, with the
-//                 Love–Weber stress and (if tracked) energies summed in the same pass
+//                 Love–Weber stress and (if tracked) energies summed in the same pass; the tangential law
+//                 (numerics.tangentialModel) is a template parameter chosen once per pass
 //   4. kick       forces gathered per particle in a fixed order, half kick v += dt/2 a
 //   5. control    the cell controller (if any) sets L for the next step
 // Deterministic: every reduction is over fixed-size chunks summed in chunk order, and forces are gathered
@@ -127,8 +128,13 @@ class Simulation {
   void resizeChunks();  // m_chunks for the current pair and particle counts
   void computeContacts();
   Simulation() = default;  // for restoreState
-  template <bool kEnergy, bool kDamping, bool kAffine>
+  template <bool kMindlinDeresiewicz>
+  void dispatchContactPass();
+  template <bool kEnergy, bool kDamping, bool kAffine, bool kMindlinDeresiewicz>
   void contactPass();
+  // Sizes the Mindlin–Deresiewicz history array for the selected law (empty for the default law; when
+  // switching to it, fresh histories start from the stored normal forces).
+  void syncTangentialHistory();
   void kick();
   template <bool kLocalDamping>
   void kickPass();

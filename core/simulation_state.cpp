@@ -1,6 +1,8 @@
 // Bit-exact save/restore of a Simulation (verification ladder §5: save at step N, reload, run k steps:
 // identical to an unbroken run). Everything the next step reads is saved, including the neighbour-list
 // reference positions and the previous stress used by the boundary-work integral.
+#include <cmath>
+#include <cstddef>
 #include <cstring>
 
 #include "binary_io.hpp"
@@ -9,7 +11,19 @@
 namespace fl {
 
 namespace {
-constexpr std::uint32_t kStateVersion = 2;
+// 3: numerics carry the tangential model; the Mindlin–Deresiewicz history follows the contact history.
+// 2: read for compatibility (the default tangential law, no extra history).
+constexpr std::uint32_t kStateVersion = 3;
+
+// NumericsSettings as written by state version 2 (same members and order, no tangentialModel).
+struct NumericsSettingsV2 {
+  double timeStepFactor, timeStep, localDamping, restitution, densityScale, skin;
+  bool trackEnergy;
+  int threads;
+};
+static_assert(sizeof(NumericsSettingsV2) == 56 &&
+                  offsetof(NumericsSettingsV2, threads) == offsetof(NumericsSettings, threads),
+              "NumericsSettings must keep the version-2 members first, in order");
 
 void putMat(BinaryWriter& w, const Mat3& m) {
   for (int k = 0; k < 9; ++k) w.put(m.data()[k]);
@@ -56,6 +70,7 @@ void Simulation::saveState(BinaryWriter& w) const {
   w.putVector(m_c.second);
   w.putVector(m_c.image);
   w.putVector(m_c.history);
+  w.putVector(m_c.mdHistory);  // empty with the default tangential law
   w.putVector(m_c.normal);
   w.putVector(m_c.overlap);
   w.putVector(m_c.distance);
@@ -79,8 +94,8 @@ void Simulation::saveState(BinaryWriter& w) const {
 
 Simulation Simulation::restoreState(BinaryReader& r) {
   const auto version = r.get<std::uint32_t>("state version");
-  if (version != kStateVersion)
-    r.fail("simulation state version " + std::to_string(version) + " is not supported (expected " +
+  if (version != kStateVersion && version != 2)
+    r.fail("simulation state version " + std::to_string(version) + " is not supported (expected 2 or " +
            std::to_string(kStateVersion) + ")");
   Simulation s;
   const auto nm = r.get<std::uint64_t>("material count");
@@ -94,11 +109,28 @@ Simulation Simulation::restoreState(BinaryReader& r) {
     m.friction = r.get<double>("material friction");
     s.m_materials.push_back(m);
   }
-  s.m_num = r.get<NumericsSettings>("numerics");
-  {  // inspect the flag's byte without loading it as a bool (a corrupted byte would be UB)
+  if (version == 2) {
+    const auto v2 = r.get<NumericsSettingsV2>("numerics");
+    unsigned char b;  // inspect the flag's byte without loading it as a bool (a corrupted byte would be UB)
+    std::memcpy(&b, &v2.trackEnergy, 1);
+    if (b > 1) r.fail("invalid numerics.trackEnergy flag");
+    s.m_num.timeStepFactor = v2.timeStepFactor;
+    s.m_num.timeStep = v2.timeStep;
+    s.m_num.localDamping = v2.localDamping;
+    s.m_num.restitution = v2.restitution;
+    s.m_num.densityScale = v2.densityScale;
+    s.m_num.skin = v2.skin;
+    s.m_num.trackEnergy = v2.trackEnergy;
+    s.m_num.threads = v2.threads;
+    s.m_num.tangentialModel = TangentialModel::MindlinNoSlip;
+  } else {
+    s.m_num = r.get<NumericsSettings>("numerics");
     unsigned char b;
     std::memcpy(&b, &s.m_num.trackEnergy, 1);
     if (b > 1) r.fail("invalid numerics.trackEnergy flag");
+    if (!isTangentialModel(s.m_num.tangentialModel))
+      r.fail("invalid numerics.tangentialModel " + std::to_string(static_cast<int>(s.m_num.tangentialModel)) +
+             " (allowed: " + tangentialModelList() + ")");
   }
   try {
     s.m_num.validate();
@@ -134,6 +166,7 @@ Simulation Simulation::restoreState(BinaryReader& r) {
   c.second = r.getVector<std::int32_t>("pair second");
   c.image = r.getVector<Image>("pair image");
   c.history = r.getVector<ContactHistory>("contact history");
+  if (version >= 3) c.mdHistory = r.getVector<MdHistory>("Mindlin-Deresiewicz history");
   c.normal = r.getVector<Vec3>("contact normals");
   c.overlap = r.getVector<double>("contact overlaps");
   c.distance = r.getVector<double>("contact distances");
@@ -143,6 +176,17 @@ Simulation Simulation::restoreState(BinaryReader& r) {
   if (c.second.size() != np || c.image.size() != np || c.history.size() != np || c.normal.size() != np ||
       c.overlap.size() != np || c.distance.size() != np || c.normalForce.size() != np || c.force.size() != np)
     r.fail("contact arrays have inconsistent lengths");
+  const bool md = s.m_num.tangentialModel == TangentialModel::MindlinDeresiewicz;
+  if (c.mdHistory.size() != (md ? np : 0))
+    r.fail("the Mindlin-Deresiewicz history has " + std::to_string(c.mdHistory.size()) + " entries, expected " +
+           std::to_string(md ? np : 0));
+  for (std::size_t k = 0; k < c.mdHistory.size(); ++k) {
+    const MdHistory& h = c.mdHistory[k];
+    std::int32_t branch;
+    std::memcpy(&branch, &h.branch, sizeof branch);
+    if (branch < 0 || branch > 2 || !(h.locked >= 0.0) || !std::isfinite(h.locked))
+      r.fail("invalid Mindlin-Deresiewicz history of contact " + std::to_string(k));
+  }
   for (std::size_t k = 0; k < np; ++k)
     if (c.first[k] < 0 || c.second[k] < 0 || static_cast<std::size_t>(c.first[k]) >= n ||
         static_cast<std::size_t>(c.second[k]) >= n)
@@ -171,6 +215,8 @@ Simulation Simulation::restoreState(BinaryReader& r) {
 
 void Simulation::reconfigure(const Material& material, const NumericsSettings& numerics) {
   numerics.validate();
+  if (!isTangentialModel(numerics.tangentialModel))
+    throw InputError("reconfigure: unknown numerics.tangential_model; allowed: " + tangentialModelList());
   for (std::uint16_t m : m_p.material)
     if (m != 0) throw InputError("reconfigure: the specimen uses several materials; a scene defines one");
   m_materials = {material};
@@ -185,6 +231,7 @@ void Simulation::reconfigure(const Material& material, const NumericsSettings& n
   m_pairs = PairTable(m_materials, m_num.restitution);
   m_rayleigh = rayleighTimeStep(m_p, m_materials, m_num.densityScale);
   m_dt = m_num.timeStep > 0.0 ? m_num.timeStep : m_num.timeStepFactor * m_rayleigh;
+  syncTangentialHistory();  // the scene may select another tangential law
 }
 
 }  // namespace fl
