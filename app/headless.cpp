@@ -11,6 +11,7 @@
 #include <fstream>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/errors.hpp"
 #include "core/measurements.hpp"
@@ -39,7 +40,7 @@ void usage(std::FILE* f) {
                "       fabriclab-run --schema-doc [FILE]          write the scene-file reference (Markdown)\n"
                "options:\n"
                "  --out DIR          results folder (overrides the scene's output.directory)\n"
-               "  --overwrite        allow writing into a non-empty results folder\n"
+               "  --overwrite        replace the results of a previous run in a non-empty folder\n"
                "  --threads N        OpenMP threads (results do not depend on it)\n"
                "  --export-csv FILE  write the final packing as CSV (x,y,z,r)\n"
                "  --export-lammps FILE  write the final packing as a LAMMPS data file (atom_style sphere)\n"
@@ -48,12 +49,30 @@ void usage(std::FILE* f) {
 
 // Refuses a results folder that exists and is not empty (unless overwrite), or that cannot be written,
 // before the run starts rather than after an hour.
-void prepareOutputDirectory(const std::string& dir, bool overwrite) {
+// What to do with a results folder that already holds files.
+enum class ExistingResults {
+  Refuse,   // a fresh run without --overwrite
+  Keep,     // --restart: the run continues its own results (the time series are append logs)
+  Replace,  // a fresh run with --overwrite: FabricLab's previous results go, other files stay
+};
+
+void prepareOutputDirectory(const std::string& dir, ExistingResults existing) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (fs::exists(dir, ec) && !fs::is_directory(dir, ec)) throw IoError(dir + ": exists and is not a folder");
-  if (fs::exists(dir, ec) && !fs::is_empty(dir, ec) && !overwrite)
-    throw IoError(dir + ": results folder is not empty; choose another --out or pass --overwrite");
+  if (fs::exists(dir, ec) && !fs::is_empty(dir, ec)) {
+    if (existing == ExistingResults::Refuse)
+      throw IoError(dir + ": results folder is not empty; choose another --out or pass --overwrite");
+    // A fresh run replaces FabricLab's own results (the time series are append logs, kept across restarts,
+    // so they must go); anything else the user keeps in the folder stays.
+    const std::vector<const char*> ours = {"timeseries.csv", "cycles.csv", "warnings.txt", "stages.json",
+                                           "scene.json", "checkpoints", "paraview"};
+    for (const char* name : existing == ExistingResults::Replace ? ours : std::vector<const char*>{}) {
+      const fs::path p = fs::path(dir) / name;
+      if (fs::exists(p, ec) && fs::remove_all(p, ec) == static_cast<std::uintmax_t>(-1))
+        throw IoError(p.string() + ": cannot remove the previous result (--overwrite): " + ec.message());
+    }
+  }
   fs::create_directories(dir, ec);
   if (ec) throw IoError(dir + ": cannot create the results folder: " + ec.message());
   const std::string probe = (fs::path(dir) / ".write-test").string();
@@ -164,13 +183,14 @@ int runHeadless(int argc, char** argv) {
       Scene scene = loadScene(scenePath);
       if (threads > 0) scene.numerics.threads = threads;
       if (outGiven) scene.output.directory = outDir;
-      if (!scene.output.directory.empty()) prepareOutputDirectory(scene.output.directory, overwrite);
+      if (!scene.output.directory.empty())
+        prepareOutputDirectory(scene.output.directory, overwrite ? ExistingResults::Replace : ExistingResults::Refuse);
       run = std::make_unique<Runner>(std::move(scene));
     }
     const Scene& scene = run->scene();
     std::unique_ptr<RunOutputs> outputs;
     if (!scene.output.directory.empty()) {
-      if (!restart.empty()) prepareOutputDirectory(scene.output.directory, true);
+      if (!restart.empty()) prepareOutputDirectory(scene.output.directory, ExistingResults::Keep);
       outputs = std::make_unique<RunOutputs>(scene.output.directory, scene);
       run->addObserver(outputs.get());
     }
@@ -184,7 +204,8 @@ int runHeadless(int argc, char** argv) {
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
     const auto t0 = std::chrono::steady_clock::now();
-    long lastSteps = sim.stepCount();
+    const long firstStep = sim.stepCount();  // > 0 when the run continues a checkpoint
+    long lastSteps = firstStep;
     auto lastReport = t0;
     double rate = 0;
     while (!run->finished()) {
@@ -223,8 +244,8 @@ int runHeadless(int argc, char** argv) {
     if (!exportCsv.empty()) writePackingCsv(exportCsv, sim.particles(), sim.cell());
     if (!exportLammps.empty()) writeLammpsData(exportLammps, sim.particles(), sim.cell(), sim.materials());
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::printf("wall time %s, %.3g particle-steps/s\n", duration(wall).c_str(),
-                sim.stepCount() * double(sim.particles().size()) / std::max(wall, 1e-9));
+    std::printf("wall time %s, %ld steps, %.3g particle-steps/s\n", duration(wall).c_str(), sim.stepCount() - firstStep,
+                double(sim.stepCount() - firstStep) * double(sim.particles().size()) / std::max(wall, 1e-9));
     return 0;
   } catch (const InputError& e) {
     std::fprintf(stderr, "fabriclab-run: input error: %s\n", e.what());

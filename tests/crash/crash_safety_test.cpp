@@ -237,6 +237,7 @@ TEST_F(CrashSafety, KillAnywhereLosesNothingAndRestarts) {
     Child c;
     if (ck.empty()) {
       c = spawnRun({m_scene.string(), "--overwrite", "--quiet"}, m_root / "run");
+      before.clear();  // a fresh run with --overwrite replaces the previous results
       ++fresh;
     } else {
       c = spawnRun({"--restart", ck.string(), "--quiet"}, m_root / "run");
@@ -331,6 +332,33 @@ TEST_F(CrashSafety, NonEmptyResultsFolderIsRefusedWithoutOverwrite) {
   EXPECT_EQ(slurp(m_root / "run.out").find("FabricLab:"), std::string::npos) << "the run started";
   EXPECT_EQ(slurp(results / "old-result.txt"), "precious\n");
   EXPECT_FALSE(fs::exists(results / "timeseries.csv"));
+}
+
+TEST_F(CrashSafety, OverwriteReplacesThePreviousResultsAndKeepsOtherFiles) {
+  // A short scene (compression and a 300-step hold): run it, then again with --overwrite into the same folder.
+  nlohmann::json j = nlohmann::json::parse(sceneJson(m_root / "results"));
+  j["stages"] = nlohmann::json::array({j["stages"][0], j["stages"][1]});
+  j["stages"][1]["steps"] = 300;
+  const fs::path scene = m_root / "short.json", results = m_root / "results";
+  std::ofstream(scene) << j.dump(2);
+  ASSERT_EQ(waitChild(spawnRun({scene.string(), "--quiet"}, m_root / "run")), 0) << errText("run");
+  const std::string first = slurp(results / "timeseries.csv"), stages = slurp(results / "stages.json");
+  ASSERT_GT(first.size(), 200u);
+  std::ofstream(results / "my-notes.txt") << "keep me\n";
+  fs::create_directories(results / "checkpoints");
+  std::ofstream(results / "checkpoints" / "stale.ckpt") << "old";
+  ASSERT_EQ(waitChild(spawnRun({scene.string(), "--overwrite", "--quiet"}, m_root / "run")), 0) << errText("run");
+  // the same deterministic run: identical files, not the old rows followed by the new ones
+  EXPECT_EQ(slurp(results / "timeseries.csv"), first);
+  // (stages.json holds wall times: compare what it lists)
+  const auto countStages = [](const std::string& text) {
+    const auto v = nlohmann::json::parse(text);
+    return v.is_array() ? v.size() : v.value("stages", nlohmann::json::array()).size();
+  };
+  EXPECT_EQ(countStages(slurp(results / "stages.json")), countStages(stages));
+  EXPECT_GE(countStages(stages), 2u);
+  EXPECT_FALSE(fs::exists(results / "checkpoints" / "stale.ckpt"));
+  EXPECT_EQ(slurp(results / "my-notes.txt"), "keep me\n");
 }
 
 TEST_F(CrashSafety, UnwritableResultsFolderIsRefusedBeforeTheRun) {
