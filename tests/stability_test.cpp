@@ -1,6 +1,7 @@
 // Numerical stability on stiff and extreme cases (reduced size, for CI; the full suite is a study):
 // every case either runs with a bounded energy-balance error and overlaps below the stated fraction of the
 // radius, or stops with a clear diagnostic — never a silent NaN. Each guard is triggered by a test.
+// The cases are shared with the full-size study (app/stability_cases.hpp, `fabriclab-accuracy --stability`).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/stability_cases.hpp"
 #include "core/errors.hpp"
 #include "core/runner.hpp"
 
@@ -19,8 +21,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr double kOverlapBound = 0.05;  // stated bound: overlaps below 5 % of the smaller radius
-constexpr double kEnergyBound = 0.05;   // stated bound on the energy-balance error of a completed case
+using stability::kEnergyBound;
+using stability::kOverlapBound;
+using stability::Outcome;
+using stability::tryRun;
+constexpr int kCount = 400;  // reduced size for CI (the full study uses 4000)
 
 fs::path scratch(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("fl-stability-" + name + "-" + std::to_string(::getpid()));
@@ -29,15 +34,7 @@ fs::path scratch(const std::string& name) {
   return d;
 }
 
-json base() {
-  return json::parse(R"({
-    "specimen": {"count": 400, "solid_fraction": 0.3, "seed": 3},
-    "numerics": {"time_step_factor": 0.3, "local_damping": 0.1, "density_scale": 100, "threads": 1},
-    "servo": {"max_strain_rate": 20, "max_inertial_number": 0.02, "unbalanced_tolerance": 0.01},
-    "output": {"sample_interval": 500, "checkpoint_at_stage_end": true},
-    "stages": []
-  })");
-}
+json base() { return stability::baseScene(kCount); }
 
 // Runs to the end; returns the runner. Any exception propagates.
 Runner runAll(const json& j) {
@@ -47,33 +44,6 @@ Runner runAll(const json& j) {
   return r;
 }
 
-struct Outcome {
-  bool completed = false;
-  std::string error;
-  double maxOverlap = 0, maxEnergyError = 0;
-  bool finite = true;
-};
-
-Outcome tryRun(const json& j) {
-  Outcome o;
-  try {
-    Runner r(parseScene(j, "stability.json"));
-    bool more = true;
-    while (more) {
-      more = r.advance(200);
-      o.maxOverlap = std::max(o.maxOverlap, r.simulation().diagnostics().maxOverlapRatio);
-    }
-    for (const Sample& s : r.samples()) {
-      o.maxEnergyError = std::max(o.maxEnergyError, s.energyError);
-      o.finite = o.finite && std::isfinite(s.p) && std::isfinite(s.q) && std::isfinite(s.voidRatio);
-    }
-    o.completed = true;
-  } catch (const InstabilityError& e) {
-    o.error = e.what();
-  }
-  return o;
-}
-
 }  // namespace
 
 TEST(StabilitySuite, ExtremeCasesRunBoundedOrStopWithADiagnostic) {
@@ -81,39 +51,14 @@ TEST(StabilitySuite, ExtremeCasesRunBoundedOrStopWithADiagnostic) {
   // one glass specimen at 318 kPa, branched into every case
   json prep = base();
   prep["output"]["directory"] = (dir / "prep").string();
-  prep["stages"] = json::array({{{"type", "isotropic_compression"}, {"pressure", 318e3}, {"friction", 0.1}, {"friction_after", 0.235}}});
+  prep["stages"] = stability::preparationStages(0.1);
   Runner prepared = runAll(prep);
   const std::string specimen = prepared.summaries().back().checkpoint;
   ASSERT_TRUE(fs::exists(specimen));
 
-  struct Case {
-    std::string name;
-    std::function<void(json&)> edit;
-    bool mayStop;  // allowed to stop with a diagnostic instead of completing
-  };
-  auto cyc = [](double rate) {
-    return json{{"type", "cyclic"}, {"drainage", "undrained"}, {"amplitude", 2.3e-4}, {"cycles", 1}, {"strain_rate", rate}};
-  };
-  auto iso = [](double p) { return json{{"type", "isotropic_compression"}, {"pressure", p}}; };
-  const std::vector<Case> cases = {
-      {"glass x10 stiffer", [&](json& j) { j["material"]["shear_modulus"] = 286.88e9; j["stages"] = {iso(318e3), cyc(1)}; }, false},
-      {"glass x100 stiffer", [&](json& j) { j["material"]["shear_modulus"] = 2868.8e9; j["stages"] = {iso(318e3), cyc(1)}; }, false},
-      // soft: at 50 kPa the overlaps are ~6.5 % of the radius (SC estimate), beyond the default guard ...
-      {"very soft G = 10 MPa", [&](json& j) { j["material"]["shear_modulus"] = 10e6; j["stages"] = {iso(50e3), cyc(1)}; }, true},
-      // ... and with the guard raised on purpose the run completes with bounded energy error
-      {"very soft, limit 0.15", [&](json& j) {
-         j["material"]["shear_modulus"] = 10e6;
-         j["guards"] = {{"max_overlap_ratio", 0.15}};
-         j["stages"] = {iso(50e3), cyc(1)};
-       }, false},
-      {"1 kPa", [&](json& j) { j["stages"] = {iso(1e3), cyc(1)}; }, false},
-      {"10 MPa (jammed dense)", [&](json& j) { j["stages"] = {iso(10e6), cyc(1)}; }, false},
-      {"mu = 0", [&](json& j) { j["material"]["friction"] = 0.0; j["stages"] = {iso(318e3), cyc(1)}; }, false},
-      {"mu = 1", [&](json& j) { j["material"]["friction"] = 1.0; j["stages"] = {iso(318e3), cyc(1)}; }, false},
-      {"no damping", [&](json& j) { j["numerics"]["local_damping"] = 0.0; j["stages"] = {cyc(1)}; }, false},
-      {"high strain rate", [&](json& j) { j["stages"] = {cyc(100)}; }, false},
-  };
-  for (const Case& c : cases) {
+  const std::vector<stability::Case> cases = stability::branchCases();
+  ASSERT_EQ(cases.size(), 10u);
+  for (const stability::Case& c : cases) {
     SCOPED_TRACE(c.name);
     json j = base();
     j["specimen"] = {{"source", "checkpoint"}, {"path", specimen}};
@@ -122,7 +67,7 @@ TEST(StabilitySuite, ExtremeCasesRunBoundedOrStopWithADiagnostic) {
     const Outcome o = tryRun(j);
     if (o.completed) {
       EXPECT_TRUE(o.finite);
-      EXPECT_LT(o.maxOverlap, j.contains("guards") ? 0.15 : kOverlapBound);
+      EXPECT_LT(o.maxOverlap, c.overlapLimit);
       EXPECT_LT(o.maxEnergyError, kEnergyBound);
     } else {
       EXPECT_TRUE(c.mayStop) << o.error;
@@ -136,17 +81,10 @@ TEST(StabilitySuite, ExtremeCasesRunBoundedOrStopWithADiagnostic) {
 
 TEST(StabilitySuite, LooseGasAndTenToOneSizeRatio) {
   // a gas with no contacts and no damping: nothing to do but must stay finite and conserve energy
-  json g = base();
-  g["numerics"]["local_damping"] = 0.0;
-  g["stages"] = json::array({{{"type", "hold"}, {"steps", 3000}}});
-  const Outcome gas = tryRun(g);
+  const Outcome gas = tryRun(stability::looseGasScene(kCount));
   EXPECT_TRUE(gas.completed) << gas.error;
   // 10:1 size ratio compressed to 100 kPa
-  json s = base();
-  s["specimen"]["diameters"] = {0.2e-3, 2e-3};
-  s["specimen"]["fractions"] = {0.9, 0.1};
-  s["stages"] = json::array({{{"type", "isotropic_compression"}, {"pressure", 100e3}}});
-  const Outcome ratio = tryRun(s);
+  const Outcome ratio = tryRun(stability::sizeRatioScene(kCount));
   EXPECT_TRUE(ratio.completed) << ratio.error;
   EXPECT_LT(ratio.maxOverlap, kOverlapBound);
 }
