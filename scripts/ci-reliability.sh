@@ -6,7 +6,8 @@
 #      synchronisation is visible to TSan (g++'s libgomp is not instrumented and gives false positives),
 #      running the multi-threaded tests with 2 threads; then the GUI engineer's hook, if present;
 #   3. a short libFuzzer pass over every reader (scripts/fuzz.sh, FL_FUZZ_SECONDS per target, default 15).
-# Sanitizer builds use -O1 -g (ASan's recommended level; compiles much faster than -O2 on 2 cores).
+# The ASan build uses clang -O2 (g++ -O1 took 573 s to build and 880 s to test here; clang -O2 190 s and
+# ~360 s with the skip list below); the TSan build uses clang -O1.
 # Prints the time of each step. Env: FL_ASAN_BUILD_DIR (default build-asan), FL_TSAN_BUILD_DIR (build-tsan),
 # FL_FUZZ_BUILD (build-fuzz), FL_JOBS (2), FL_RELIABILITY_SKIP (space-separated: asan tsan fuzz gui-tsan).
 set -euo pipefail
@@ -35,14 +36,23 @@ configure() {  # dir, extra cmake args...
 if [[ "$skip" != *" asan "* ]]; then
   t=$SECONDS
   mkdir -p "$asan"
-  configure "$asan" -DFL_SANITIZE=address,undefined
+  CC=clang CXX=clang++ configure "$asan" -DFL_SANITIZE=address,undefined \
+    "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g -DNDEBUG"
   cmake --build "$asan" -j "$jobs" >"$asan/build.log" 2>&1 || { tail -40 "$asan/build.log"; exit 1; }
   b=$((SECONDS - t)); t=$SECONDS
-  # The longest physics runs repeat code paths the other tests already take (cyclic stage, branching of a
-  # specimen, guards, the accuracy study's runs); under ASan each costs minutes, so they are left to the
-  # normal build's run (the accuracy study's metric tests still run here).
+  # The longest physics runs repeat code paths that the tests kept here already take under ASan; each costs
+  # one to five minutes under ASan (Eigen's small-vector code is not inlined there), so they run only in
+  # the normal build: the regression and accuracy runs, the extreme cases, the servo's long holds (the runner
+  # stages keep the servo modes), the reduced paper preparation, the triaxial and drained cyclic stages, the
+  # isotropic / K0-to-p' stages (K0 loading-unloading stays) and a stage started from another run's
+  # checkpoint (RestartMidCycle keeps the checkpoint reader), and the M-D 1-vs-2-thread check (Determinism
+  # keeps the 2-thread pass). Kept: every unit, closed-form and reader test, restart, cyclic undrained,
+  # K0 loading-unloading, VTK output, guards, stability (10:1 grid), and crash safety with 10 kills.
   asan_skip="Regression\.|StabilitySuite\.ExtremeCases|RunnerStages\.CyclicDrained|AccuracyStudy\."
-  (cd "$asan" && ctest --output-on-failure -j "$jobs" --timeout 900 -E "$asan_skip" >"$asan/ctest.log" 2>&1) \
+  asan_skip+="|ShippedScenes\.ReducedPaperSpecimen|RunnerStages\.DrainedAndUndrainedTriaxial|Servo\.ConstantVolumeHolds"
+  asan_skip+="|Servo\.K0Keeps|Servo\.ReachesAnIsotropic|RunnerStages\.IsotropicCompression|RunnerStages\.K0LoadingToAMean"
+  asan_skip+="|RunnerSpecimen\.AStageCanStart|MindlinDeresiewiczSimulation\.OneAndTwoThreads"
+  (cd "$asan" && FL_CRASH_KILLS=10 ctest --output-on-failure -j "$jobs" --timeout 900 -E "$asan_skip" >"$asan/ctest.log" 2>&1) \
     || { grep -E "tests passed|Failed|\*\*\*|ERROR|runtime error" "$asan/ctest.log" | head -40; exit 1; }
   step "asan+ubsan build" "$b" "ok"
   step "asan+ubsan ctest (engine + crash)" $((SECONDS - t)) "$(grep -E 'tests passed' "$asan/ctest.log")"
@@ -83,7 +93,7 @@ fi
 # ---- 3. short fuzz pass ------------------------------------------------------------------------------
 if [[ "$skip" != *" fuzz "* ]]; then
   t=$SECONDS
-  FL_JOBS="$jobs" "$root/scripts/fuzz.sh" "${FL_FUZZ_SECONDS:-15}"
+  FL_JOBS="$jobs" "$root/scripts/fuzz.sh" "${FL_FUZZ_SECONDS:-10}"
   step "fuzz (5 targets)" $((SECONDS - t)) "ok, see $FL_FUZZ_BUILD/fuzz-summary.txt"
 fi
 
