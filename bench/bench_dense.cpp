@@ -13,8 +13,11 @@
 // bit-identical across the thread counts it measured (house style §12).
 //
 //   bench_dense [--threads 1,2] [--steps 20000] [--repeats 5] [--cache FILE] [--export-lammps FILE]
-//               [--no-energy] [--skin METRES]
+//               [--no-energy] [--skin METRES] [--order file|morton] [--tile NX,NY,NZ]
+// --tile replicates the periodic packing NX x NY x NZ times (same density, stress and contacts per particle:
+// the scaling measurement of issue 6 uses 1,1,1 / 2,2,2 / 4,4,4 / 6,6,7 = 4k, 32k, 256k, 1M spheres).
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -27,6 +30,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include "core/atomic_file.hpp"
 #include "core/binary_io.hpp"
 #include "core/cell_control.hpp"
@@ -34,6 +39,7 @@
 #include "core/measurements.hpp"
 #include "core/packing_io.hpp"
 #include "core/simulation.hpp"
+#include "core/spatial_order.hpp"
 
 using namespace fl;
 
@@ -50,12 +56,15 @@ struct Options {
   std::string exportLammps;
   bool trackEnergy = true;
   double skin = 0.0;  // 0: the engine's default (0.1 x mean diameter)
+  std::array<int, 3> tile{1, 1, 1};  // periodic replicas of the packing per axis
+  bool morton = true;  // particles in Z-order (core/spatial_order.hpp); false: the cached packing's order
 };
 
 [[noreturn]] void usage(const char* msg) {
   std::fprintf(stderr,
                "bench_dense: %s\nusage: bench_dense [--threads 1,2] [--steps N] [--repeats N] [--cache FILE]\n"
-               "                   [--export-lammps FILE] [--no-energy] [--skin METRES]\n",
+               "                   [--export-lammps FILE] [--no-energy] [--skin METRES] [--order file|morton]\n"
+               "                   [--tile NX,NY,NZ]\n",
                msg);
   std::exit(2);
 }
@@ -87,6 +96,16 @@ Options parse(int argc, char** argv) {
       o.trackEnergy = false;
     } else if (a == "--skin") {
       o.skin = std::atof(value().c_str());
+    } else if (a == "--tile") {
+      std::stringstream s(value());
+      std::string t;
+      int k2 = 0;
+      while (std::getline(s, t, ',') && k2 < 3) o.tile[k2++] = std::atoi(t.c_str());
+      if (k2 != 3 || o.tile[0] < 1 || o.tile[1] < 1 || o.tile[2] < 1) usage("--tile takes three positive integers");
+    } else if (a == "--order") {
+      const std::string v = value();
+      if (v != "file" && v != "morton") usage("--order takes file or morton");
+      o.morton = v == "morton";
     } else if (a == "-h" || a == "--help") {
       usage("help");
     } else {
@@ -178,12 +197,21 @@ Simulation measuredScene(const Simulation& prepared, int threads, const Options&
   const ParticleStore& src = prepared.particles();
   const Material glass = prepared.materials().at(0);
   ParticleStore p;
-  for (std::size_t i = 0; i < src.size(); ++i) {
-    p.add(src.pos[i], src.radius[i], glass.density, src.material[i]);
-    p.vel[i] = src.vel[i];
-    p.angVel[i] = src.angVel[i];
-  }
-  PeriodicCell cell(prepared.cell().matrix());
+  const Mat3& H = prepared.cell().matrix();
+  for (int a = 0; a < o.tile[0]; ++a)
+    for (int b = 0; b < o.tile[1]; ++b)
+      for (int c = 0; c < o.tile[2]; ++c) {
+        const Vec3 shift = H * Vec3(a, b, c);
+        for (std::size_t i = 0; i < src.size(); ++i) {
+          p.add(src.pos[i] + shift, src.radius[i], glass.density, src.material[i]);
+          p.vel.back() = src.vel[i];
+          p.angVel.back() = src.angVel[i];
+        }
+      }
+  PeriodicCell cell(H * Vec3(o.tile[0], o.tile[1], o.tile[2]).asDiagonal().toDenseMatrix());
+  // Z-order: pair partners and their pair data mostly share a thread's half of the arrays (the LAMMPS data
+  // file is written from this scene, so LAMMPS reads the same order; it re-sorts by itself every 1000 steps)
+  if (o.morton) sortSpatially(p, cell);
   NumericsSettings num;
   num.timeStep = kDt;
   num.localDamping = 0.0;
@@ -193,6 +221,14 @@ Simulation measuredScene(const Simulation& prepared, int threads, const Options&
   num.trackEnergy = o.trackEnergy;
   num.threads = threads;
   return Simulation(std::move(p), cell, prepared.materials(), num);
+}
+
+// Resident set size of this process [bytes] (Linux /proc/self/statm; 0 elsewhere).
+double residentBytes() {
+  std::ifstream f("/proc/self/statm");
+  double pages = 0.0, resident = 0.0;
+  if (!(f >> pages >> resident)) return 0.0;
+  return resident * static_cast<double>(sysconf(_SC_PAGESIZE));
 }
 
 double median(std::vector<double> v) {
@@ -207,7 +243,7 @@ int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress lines appear at once when piped (tee)
   const Options o = parse(argc, argv);
   Simulation prepared = loadOrPrepare(o.cache);
-  const std::size_t n = prepared.particles().size();
+  const std::size_t n = prepared.particles().size() * static_cast<std::size_t>(o.tile[0] * o.tile[1] * o.tile[2]);
 
   {
     Simulation s0 = measuredScene(prepared, 1, o);
@@ -218,8 +254,9 @@ int main(int argc, char** argv) {
                 H(1, 1) * 1e3, H(2, 2) * 1e3, s0.particles().solidVolume() / s0.cell().volume());
     std::printf("step 0: p = %.6g Pa  Z = 2C/N = %.6f  (C = %zu, pairs in list %zu)\n", p0, counts.coordination,
                 counts.contacts, s0.contacts().size());
-    std::printf("numerics: dt = %.3g s, skin = %.6g m, energy tracking %s, steps %ld, repeats %d\n",
-                s0.timeStep(), s0.skin(), o.trackEnergy ? "on" : "off", o.steps, o.repeats);
+    std::printf("numerics: dt = %.3g s, skin = %.6g m, energy tracking %s, steps %ld, repeats %d, order %s\n",
+                s0.timeStep(), s0.skin(), o.trackEnergy ? "on" : "off", o.steps, o.repeats,
+                o.morton ? "morton" : "file");
     if (!o.exportLammps.empty()) {
       writeLammpsData(o.exportLammps, s0.particles(), s0.cell(), s0.materials());
       const Material& m = s0.materials().at(0);
@@ -239,6 +276,7 @@ int main(int argc, char** argv) {
     double pEnd, zEnd;
   };
   std::vector<Result> results;
+  double memoryPerParticle = 0.0, peakResident = 0.0;
   for (int t : o.threads) {
     std::vector<double> rates;
     Result res{t, 0, 0, 0, {}, {}, 0, 0};
@@ -248,6 +286,10 @@ int main(int argc, char** argv) {
       const auto t0 = std::chrono::steady_clock::now();
       sim.run(o.steps);
       const double s = seconds(t0);
+      if (results.empty() && r == 0) {
+        memoryPerParticle = static_cast<double>(sim.memoryBytes()) / static_cast<double>(n);
+        peakResident = residentBytes();
+      }
       rates.push_back(static_cast<double>(n) * static_cast<double>(o.steps) / s);
       profiles.push_back(sim.profile());
       if (r == 0) {
@@ -267,7 +309,10 @@ int main(int argc, char** argv) {
     results.push_back(std::move(res));
   }
 
-  std::printf("\n%-8s %14s %14s %14s %10s\n", "threads", "median p-st/s", "min", "max", "rebuilds");
+  std::printf("\nmemory: %.0f bytes per particle in the engine's arrays (Simulation::memoryBytes); process "
+              "resident %.0f MB after the first run (includes the cached packing and LAMMPS-export scene)\n",
+              memoryPerParticle, peakResident / 1e6);
+  std::printf("%-8s %14s %14s %14s %10s\n", "threads", "median p-st/s", "min", "max", "rebuilds");
   for (const Result& r : results)
     std::printf("%-8d %14.4e %14.4e %14.4e %10ld\n", r.threads, r.median, r.lo, r.hi, r.profile.rebuilds);
   for (const Result& r : results) {
@@ -291,6 +336,8 @@ int main(int argc, char** argv) {
     if (!same) return 1;
   }
   // machine-readable summary
-  for (const Result& r : results) std::printf("result: threads=%d rate=%.6e\n", r.threads, r.median);
+  for (const Result& r : results)
+    std::printf("result: threads=%d rate=%.6e ns_per_particle_step=%.3f N=%zu bytes_per_particle=%.0f\n", r.threads,
+                r.median, 1e9 / r.median, n, memoryPerParticle);
   return 0;
 }

@@ -63,8 +63,8 @@ export_line="$(grep '^export:' "$work/fabriclab.txt")" || die "bench_dense print
 field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" <<<"$export_line"; }
 N="$(field N)"; E="$(field E)"; nu="$(field nu)"; mu="$(field mu)"; skin="$(field skin)"; dt="$(field dt)"
 fl_p0="$(field p0)"; fl_z0="$(field Z0)"
-fl_rate1="$(sed -n 's/^result: threads=1 rate=//p' "$work/fabriclab.txt")"
-fl_rate2="$(sed -n 's/^result: threads=2 rate=//p' "$work/fabriclab.txt")"
+fl_rate1="$(sed -n 's/^result: threads=1 rate=\([^ ]*\).*/\1/p' "$work/fabriclab.txt")"
+fl_rate2="$(sed -n 's/^result: threads=2 rate=\([^ ]*\).*/\1/p' "$work/fabriclab.txt")"
 
 # ---- 4. LAMMPS --------------------------------------------------------------------------------------
 cat >"$work/in.dense" <<EOF

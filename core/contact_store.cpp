@@ -15,6 +15,13 @@ void ContactStore::resizeResults() {
   distance.assign(n, 0.0);
   normalForce.assign(n, 0.0);
   force.assign(n, Vec3::Zero());
+  kick.assign(n, KickTerms{});
+}
+
+void ContactStore::deriveKickTerms() {
+  kick.assign(size(), KickTerms{});
+  for (std::size_t p = 0; p < size(); ++p)
+    if (overlap[p] > 0.0) kick[p] = {force[p], normal[p].cross(force[p]), 0.5 * overlap[p]};
 }
 
 void ContactStore::buildAdjacency(std::size_t particleCount) {

@@ -45,6 +45,14 @@ struct MdHistory {
   std::int32_t pad = 0;            // explicit, so checkpoints hold no indeterminate bytes
 };
 
+// What the kick gathers of one pair, in one 64-byte line (issue 6): the force on j, the moment n x f and
+// delta/2, so a particle's torque -(r - delta/2) n x f needs no other pair array. Zero when not touching.
+struct alignas(64) KickTerms {
+  Vec3 force = Vec3::Zero();   // f on j [N] (on i: -f)
+  Vec3 moment = Vec3::Zero();  // n x f [N]
+  double halfOverlap = 0.0;    // delta / 2 [m]
+};
+
 struct ContactStore {
   // pair definition (rebuilt with the neighbour list)
   std::vector<std::int32_t> first, second;  // particle indices i < j
@@ -58,6 +66,7 @@ struct ContactStore {
   std::vector<double> distance; // |branch| [m], branch vector = distance * normal
   std::vector<double> normalForce;  // F_n on j along n, elastic + damping, >= 0 [N]
   std::vector<Vec3> force;      // total contact force on j [N] (on i it is -force)
+  std::vector<KickTerms> kick;  // the kick's copy of force, n x force and delta/2 (derived, not saved)
   // adjacency: pairs of particle k are adjEntry[adjStart[k] .. adjStart[k+1]) as (pair << 1 | side),
   // side 0 when k is the pair's first particle, 1 when second.
   std::vector<std::int32_t> adjStart, adjEntry;
@@ -67,6 +76,7 @@ struct ContactStore {
   Vec3 branch(std::size_t p) const { return distance[p] * normal[p]; }
   std::size_t activeCount() const;
   void resizeResults();
+  void deriveKickTerms();  // kick from force, normal and overlap (after a checkpoint is read)
   void buildAdjacency(std::size_t particleCount);
 };
 

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include "contact_kernels.hpp"
 #include "errors.hpp"
@@ -283,6 +284,7 @@ void Simulation::contactPass() {
   double* normalForce = m_c.normalForce.data();
   Vec3* normal = m_c.normal.data();
   Vec3* force = m_c.force.data();
+  KickTerms* kickTerms = m_c.kick.data();
   const PairTable& table = m_pairs;
   Chunk* chunks = m_chunks.data();
 #pragma omp parallel for num_threads(m_num.threads) schedule(static)
@@ -303,6 +305,7 @@ void Simulation::contactPass() {
           overlap[p] = 0.0;
           normalForce[p] = 0.0;
           force[p].setZero();
+          kickTerms[p] = KickTerms{};
           hist[p] = ContactHistory{};
           if constexpr (kMindlinDeresiewicz) {
             // the contact opened: its locked micro-slip energy is dissipated
@@ -370,6 +373,7 @@ void Simulation::contactPass() {
       normal[p] = n;
       normalForce[p] = fn;
       force[p] = f;
+      kickTerms[p] = {f, n.cross(f), 0.5 * delta};
       acc.stress.noalias() += f * d.transpose();
       acc.stiffness += kn * n.cwiseProduct(d).cwiseAbs2();
       acc.sumForce += f.norm();
@@ -434,9 +438,7 @@ void Simulation::kickPass() {
   const double alpha = m_num.localDamping;
   const std::int32_t* adjStart = m_c.adjStart.data();
   const std::int32_t* adjEntry = m_c.adjEntry.data();
-  const Vec3* force = m_c.force.data();
-  const Vec3* normal = m_c.normal.data();
-  const double* overlap = m_c.overlap.data();
+  const KickTerms* kt = m_c.kick.data();
   const double* rad = m_p.radius.data();
   Vec3* F = m_p.force.data();
   Vec3* T = m_p.torque.data();
@@ -455,14 +457,12 @@ void Simulation::kickPass() {
       const double ri = rad[i];
       for (int e = adjStart[i]; e < adjStart[i + 1]; ++e) {
         const int entry = adjEntry[e];
-        const int p = entry >> 1;
-        const Vec3 fp = force[p];
+        const KickTerms& c = kt[entry >> 1];
         // torque = -(r_self - delta/2) n x f on both particles (contact point on the pair axis)
-        const double lever = ri - 0.5 * overlap[p];
-        t -= lever * normal[p].cross(fp);
+        t -= (ri - c.halfOverlap) * c.moment;
         // side 1 (second particle) receives +f, side 0 receives -f
         const double sign = static_cast<double>(((entry & 1) << 1) - 1);
-        f += sign * fp;
+        f += sign * c.force;
       }
       F[i] = f;
       T[i] = t;
@@ -485,6 +485,16 @@ void Simulation::kickPass() {
     if (m_num.trackEnergy)
       for (std::size_t k = 0; k < nchunks; ++k) m_energy.localDampingWork += m_chunks[k].localDamping;
   }
+}
+
+std::size_t Simulation::memoryBytes() const {
+  auto b = [](const auto& v) { return v.capacity() * sizeof(typename std::decay_t<decltype(v)>::value_type); };
+  const ParticleStore& p = m_p;
+  const ContactStore& c = m_c;
+  return b(p.pos) + b(p.vel) + b(p.angVel) + b(p.force) + b(p.torque) + b(p.radius) + b(p.invMass) +
+         b(p.invInertia) + b(p.id) + b(p.material) + b(p.image) + b(c.first) + b(c.second) + b(c.image) +
+         b(c.history) + b(c.mdHistory) + b(c.normal) + b(c.overlap) + b(c.distance) + b(c.normalForce) +
+         b(c.force) + b(c.kick) + b(c.adjStart) + b(c.adjEntry) + b(m_refPos) + b(m_chunks);
 }
 
 // ---- measures -----------------------------------------------------------------------------------

@@ -90,6 +90,9 @@ class Simulation {
   double unbalancedForceRatio() const;  // mean |F_i| / mean |f_c|
   const ContactDiagnostics& diagnostics() const { return m_diag; }
   const StageProfile& profile() const { return m_profile; }
+  // Heap bytes held by the state (particle and pair arrays by capacity, history, adjacency, reduction
+  // chunks); the neighbour grid is a temporary of each rebuild and not counted.
+  std::size_t memoryBytes() const;
 
   // commands (apply between steps)
   void setVelocityGradient(const Mat3& L) { m_cell.setVelocityGradient(L); }

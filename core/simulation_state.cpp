@@ -192,6 +192,7 @@ Simulation Simulation::restoreState(BinaryReader& r) {
         static_cast<std::size_t>(c.second[k]) >= n)
       r.fail("contact " + std::to_string(k) + " names a particle that does not exist");
   c.buildAdjacency(n);
+  c.deriveKickTerms();
   s.m_dt = r.get<double>("time step");
   s.m_time = r.get<double>("time");
   s.m_rayleigh = r.get<double>("rayleigh step");
