@@ -16,6 +16,16 @@
 
 using namespace fl;
 
+namespace {
+Packing gas(int count, double solidFraction, std::uint64_t seed) {
+  GasSpec g;
+  g.count = count;
+  g.solidFraction = solidFraction;
+  g.seed = seed;
+  return generateGas(g);
+}
+}  // namespace
+
 TEST(SpatialOrder, MortonCodeInterleavesTenBitsPerAxis) {
   const double q = 1.0 / 1024.0;
   EXPECT_EQ(mortonCode(Vec3(0, 0, 0)), 0u);
@@ -31,11 +41,7 @@ TEST(SpatialOrder, MortonCodeInterleavesTenBitsPerAxis) {
 }
 
 TEST(SpatialOrder, SortingIsAPermutationThatKeepsParticlesAndPairs) {
-  GasSpec g;
-  g.count = 800;
-  g.solidFraction = 0.3;
-  g.seed = 7;
-  Packing pk = generateGas(g);
+  Packing pk = gas(800, 0.3, 7);
   for (std::size_t i = 0; i < pk.particles.size(); ++i) {  // distinct velocities and spins to follow
     pk.particles.vel[i] = Vec3(double(i), 0.5 * double(i), -double(i));
     pk.particles.angVel[i] = Vec3(0, double(i), 1);
@@ -88,10 +94,7 @@ TEST(SpatialOrder, SortingIsAPermutationThatKeepsParticlesAndPairs) {
 }
 
 TEST(SpatialOrder, RejectsAnOrderThatIsNotAPermutation) {
-  GasSpec g;
-  g.count = 10;
-  g.solidFraction = 0.2;
-  Packing pk = generateGas(g);
+  Packing pk = gas(10, 0.2, 1);
   EXPECT_THROW(reorderParticles(pk.particles, {0, 1, 2}), InputError);
   std::vector<std::size_t> dup{0, 1, 2, 3, 4, 5, 6, 7, 8, 8};
   EXPECT_THROW(reorderParticles(pk.particles, dup), InputError);
@@ -102,11 +105,7 @@ TEST(SpatialOrder, RejectsAnOrderThatIsNotAPermutation) {
 // The memory figure of the scaling benchmark (Simulation::memoryBytes) counts every particle and pair array:
 // at least their element sizes, at most what vector growth can add (the arrays are sized, not grown).
 TEST(SpatialOrder, MemoryBytesCountsParticleAndPairArrays) {
-  GasSpec g;
-  g.count = 500;
-  g.solidFraction = 0.3;
-  g.seed = 5;
-  Packing pk = generateGas(g);
+  Packing pk = gas(500, 0.3, 5);
   const std::size_t n = pk.particles.size();
   Simulation sim(std::move(pk.particles), pk.cell, {Material::paperGlass()}, NumericsSettings{});
   const std::size_t pairs = sim.contacts().size();
