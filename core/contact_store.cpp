@@ -4,24 +4,12 @@ namespace fl {
 
 std::size_t ContactStore::activeCount() const {
   std::size_t n = 0;
-  for (double d : overlap) n += d > 0.0;
+  for (const PairResult& r : result) n += r.overlap > 0.0;
   return n;
 }
 
 void ContactStore::resizeResults() {
-  const std::size_t n = size();
-  normal.assign(n, Vec3::Zero());
-  overlap.assign(n, 0.0);
-  distance.assign(n, 0.0);
-  normalForce.assign(n, 0.0);
-  force.assign(n, Vec3::Zero());
-  kick.assign(n, KickTerms{});
-}
-
-void ContactStore::deriveKickTerms() {
-  kick.assign(size(), KickTerms{});
-  for (std::size_t p = 0; p < size(); ++p)
-    if (overlap[p] > 0.0) kick[p] = {force[p], normal[p].cross(force[p]), 0.5 * overlap[p]};
+  result.assign(size(), PairResult{});
 }
 
 void ContactStore::buildAdjacency(std::size_t particleCount) {

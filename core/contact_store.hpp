@@ -45,12 +45,14 @@ struct MdHistory {
   std::int32_t pad = 0;            // explicit, so checkpoints hold no indeterminate bytes
 };
 
-// What the kick gathers of one pair, in one 64-byte line (issue 6): the force on j, the moment n x f and
-// delta/2, so a particle's torque -(r - delta/2) n x f needs no other pair array. Zero when not touching.
-struct alignas(64) KickTerms {
-  Vec3 force = Vec3::Zero();   // f on j [N] (on i: -f)
-  Vec3 moment = Vec3::Zero();  // n x f [N]
-  double halfOverlap = 0.0;    // delta / 2 [m]
+// The results of the last force pass for one pair, in one 64-byte line (issue 6): what the kick gathers
+// (force; normal and overlap for the torque) and what the measurements read. Zero when not touching.
+// The branch length is not stored: |l| = r_i + r_j - delta (see ContactStore::branch).
+struct alignas(64) PairResult {
+  Vec3 force = Vec3::Zero();   // total contact force on j [N] (on i it is -force)
+  Vec3 normal = Vec3::Zero();  // unit n from i to j (valid when overlap > 0)
+  double overlap = 0.0;        // delta [m]; <= 0: not touching
+  double normalForce = 0.0;    // F_n on j along n, elastic + damping, >= 0 [N]
 };
 
 struct ContactStore {
@@ -60,23 +62,23 @@ struct ContactStore {
   // history (carried over across rebuilds by key)
   std::vector<ContactHistory> history;
   std::vector<MdHistory> mdHistory;  // same length as history with the Mindlin–Deresiewicz law, else empty
-  // results of the last force pass
-  std::vector<Vec3> normal;     // unit n from i to j (valid when overlap > 0)
-  std::vector<double> overlap;  // delta [m]; <= 0: not touching
-  std::vector<double> distance; // |branch| [m], branch vector = distance * normal
-  std::vector<double> normalForce;  // F_n on j along n, elastic + damping, >= 0 [N]
-  std::vector<Vec3> force;      // total contact force on j [N] (on i it is -force)
-  std::vector<KickTerms> kick;  // the kick's copy of force, n x force and delta/2 (derived, not saved)
+  // results of the last force pass, one line per pair
+  std::vector<PairResult> result;
   // adjacency: pairs of particle k are adjEntry[adjStart[k] .. adjStart[k+1]) as (pair << 1 | side),
   // side 0 when k is the pair's first particle, 1 when second.
   std::vector<std::int32_t> adjStart, adjEntry;
 
   std::size_t size() const { return first.size(); }
-  bool active(std::size_t p) const { return overlap[p] > 0.0; }
-  Vec3 branch(std::size_t p) const { return distance[p] * normal[p]; }
+  bool active(std::size_t p) const { return result[p].overlap > 0.0; }
+  // |l| = r_i + r_j - delta and the branch vector l = |l| n from i to j's image, for a touching pair
+  double distance(std::size_t p, const std::vector<double>& radius) const {
+    return radius[first[p]] + radius[second[p]] - result[p].overlap;
+  }
+  Vec3 branch(std::size_t p, const std::vector<double>& radius) const {
+    return distance(p, radius) * result[p].normal;
+  }
   std::size_t activeCount() const;
   void resizeResults();
-  void deriveKickTerms();  // kick from force, normal and overlap (after a checkpoint is read)
   void buildAdjacency(std::size_t particleCount);
 };
 

@@ -27,15 +27,19 @@ void checkInvariants(const Simulation& sim) {
     ++seen[i];
     ++seen[j];
     if (!c.active(k)) continue;
-    if (std::abs(c.normal[k].norm() - 1.0) > 1e-12) violated("pair " + std::to_string(k) + " normal not unit");
+    const PairResult& q = c.result[k];
+    if (std::abs(q.normal.norm() - 1.0) > 1e-12) violated("pair " + std::to_string(k) + " normal not unit");
+    // the stored overlap and normal agree with the positions: l = x_j + H image - x_i = (R - delta) n
     const double R = p.radius[i] + p.radius[j];
-    if (std::abs(c.distance[k] + c.overlap[k] - R) > 1e-12 * R) violated("pair " + std::to_string(k) + " overlap");
+    const Vec3 l = p.pos[j] - p.pos[i] + sim.cell().matrix() * c.image[k].vec().cast<double>();
+    if (std::abs(l.norm() + q.overlap - R) > 1e-12 * R) violated("pair " + std::to_string(k) + " overlap");
+    if ((l - (R - q.overlap) * q.normal).norm() > 1e-9 * R) violated("pair " + std::to_string(k) + " normal");
     const Vec3& ft = c.history[k].tangentialForce;
     // round-off of the projection scales with the contact's forces, not with |F_t| (which may be ~0)
-    if (std::abs(ft.dot(c.normal[k])) > 1e-9 * ft.norm() + 1e-12 * c.normalForce[k] + 1e-300)
+    if (std::abs(ft.dot(q.normal)) > 1e-9 * ft.norm() + 1e-12 * q.normalForce + 1e-300)
       violated("pair " + std::to_string(k) + " tangential force out of the tangent plane");
     const double mu = sim.materials()[p.material[i]].friction;
-    if (ft.norm() > mu * c.normalForce[k] * (1 + 1e-9) + 1e-300)
+    if (ft.norm() > mu * q.normalForce * (1 + 1e-9) + 1e-300)
       violated("pair " + std::to_string(k) + " tangential force above the Coulomb limit");
   }
   if (c.adjStart.size() != n + 1 || c.adjEntry.size() != 2 * c.size()) violated("adjacency sizes");

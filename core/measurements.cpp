@@ -95,7 +95,7 @@ FabricMeasures fabricImpl(ForEachNormal&& each) {
 FabricMeasures fabricMeasures(const ContactStore& c) {
   return fabricImpl([&](auto&& use) {
     for (std::size_t p = 0; p < c.size(); ++p)
-      if (c.active(p)) use(c.normal[p]);
+      if (c.active(p)) use(c.result[p].normal);
   });
 }
 

@@ -134,7 +134,16 @@ class Simulation {
   template <bool kMindlinDeresiewicz>
   void dispatchContactPass();
   template <bool kEnergy, bool kDamping, bool kAffine, bool kMindlinDeresiewicz>
-  void contactPass();
+  void contactPass();  // selects one of the two below
+  // Default law: pairs gathered into blocks of touching pairs, law vectorised across them (contact_block.hpp).
+  template <bool kEnergy, bool kDamping, bool kAffine>
+  void contactPassBlocked();
+  // Mindlin–Deresiewicz law: one pair at a time (its branch history does not vectorise).
+  template <bool kEnergy, bool kDamping, bool kAffine>
+  void contactPassMindlinDeresiewicz();
+  // Sums the pass's chunk partials in chunk order into the stress, energies and diagnostics.
+  template <bool kEnergy>
+  void reduceContactChunks(std::size_t nchunks);
   // Sizes the Mindlin–Deresiewicz history array for the selected law (empty for the default law; when
   // switching to it, fresh histories start from the stored normal forces).
   void syncTangentialHistory();
@@ -163,6 +172,9 @@ class Simulation {
   EnergyLedger m_energy;
   ContactDiagnostics m_diag;
   StageProfile m_profile;
+  // Fixed reduction block (pairs or particles): results are independent of the thread count. Small enough
+  // that 2 threads share ~60 blocks of a 4000-sphere packing evenly, large enough to amortise a block's sums.
+  static constexpr std::size_t kChunk = 256;
   // Partial sums of one fixed block of pairs (or particles), reduced in block order.
   struct Chunk {
     Mat3 stress = Mat3::Zero();  // sum f (x) l [N m]

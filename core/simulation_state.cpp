@@ -71,11 +71,25 @@ void Simulation::saveState(BinaryWriter& w) const {
   w.putVector(m_c.image);
   w.putVector(m_c.history);
   w.putVector(m_c.mdHistory);  // empty with the default tangential law
-  w.putVector(m_c.normal);
-  w.putVector(m_c.overlap);
-  w.putVector(m_c.distance);
-  w.putVector(m_c.normalForce);
-  w.putVector(m_c.force);
+  {
+    // the results as the separate arrays of format versions 1-3 (the distance is derived: r_i + r_j - delta)
+    const std::size_t np = m_c.size();
+    std::vector<Vec3> normal(np), force(np);
+    std::vector<double> overlap(np), distance(np), normalForce(np);
+    for (std::size_t p = 0; p < np; ++p) {
+      const PairResult& q = m_c.result[p];
+      normal[p] = q.normal;
+      overlap[p] = q.overlap;
+      distance[p] = q.overlap > 0.0 ? m_c.distance(p, m_p.radius) : 0.0;
+      normalForce[p] = q.normalForce;
+      force[p] = q.force;
+    }
+    w.putVector(normal);
+    w.putVector(overlap);
+    w.putVector(distance);
+    w.putVector(normalForce);
+    w.putVector(force);
+  }
   // integrator and bookkeeping
   w.put(m_dt);
   w.put(m_time);
@@ -167,15 +181,17 @@ Simulation Simulation::restoreState(BinaryReader& r) {
   c.image = r.getVector<Image>("pair image");
   c.history = r.getVector<ContactHistory>("contact history");
   if (version >= 3) c.mdHistory = r.getVector<MdHistory>("Mindlin-Deresiewicz history");
-  c.normal = r.getVector<Vec3>("contact normals");
-  c.overlap = r.getVector<double>("contact overlaps");
-  c.distance = r.getVector<double>("contact distances");
-  c.normalForce = r.getVector<double>("contact normal forces");
-  c.force = r.getVector<Vec3>("contact forces");
+  const auto normal = r.getVector<Vec3>("contact normals");
+  const auto overlap = r.getVector<double>("contact overlaps");
+  const auto distance = r.getVector<double>("contact distances");  // derived data: length checked only
+  const auto normalForce = r.getVector<double>("contact normal forces");
+  const auto force = r.getVector<Vec3>("contact forces");
   const std::size_t np = c.first.size();
-  if (c.second.size() != np || c.image.size() != np || c.history.size() != np || c.normal.size() != np ||
-      c.overlap.size() != np || c.distance.size() != np || c.normalForce.size() != np || c.force.size() != np)
+  if (c.second.size() != np || c.image.size() != np || c.history.size() != np || normal.size() != np ||
+      overlap.size() != np || distance.size() != np || normalForce.size() != np || force.size() != np)
     r.fail("contact arrays have inconsistent lengths");
+  c.result.resize(np);
+  for (std::size_t q = 0; q < np; ++q) c.result[q] = {force[q], normal[q], overlap[q], normalForce[q]};
   const bool md = s.m_num.tangentialModel == TangentialModel::MindlinDeresiewicz;
   if (c.mdHistory.size() != (md ? np : 0))
     r.fail("the Mindlin-Deresiewicz history has " + std::to_string(c.mdHistory.size()) + " entries, expected " +
@@ -192,7 +208,6 @@ Simulation Simulation::restoreState(BinaryReader& r) {
         static_cast<std::size_t>(c.second[k]) >= n)
       r.fail("contact " + std::to_string(k) + " names a particle that does not exist");
   c.buildAdjacency(n);
-  c.deriveKickTerms();
   s.m_dt = r.get<double>("time step");
   s.m_time = r.get<double>("time");
   s.m_rayleigh = r.get<double>("rayleigh step");

@@ -149,19 +149,19 @@ void writeContactsVtu(const std::string& path, const Simulation& sim) {
   for (std::size_t k : active) {
     const Vec3& xi = p.pos[static_cast<std::size_t>(c.first[k])];
     pts.push_back(xi);
-    pts.push_back(xi + c.branch(k));  // towards j's image: lines across the boundary keep their length
+    pts.push_back(xi + c.branch(k, p.radius));  // towards j's image: lines across the boundary keep their length
   }
   std::string s;
   beginPiece(s, pts.size(), active.size());
   s += "      <CellData Scalars=\"normal_force\" Vectors=\"force\">\n";
   beginArray(s, "Float64", "normal_force", 1);
-  for (std::size_t k : active) put(s, c.normalForce[k]);
+  for (std::size_t k : active) put(s, c.result[k].normalForce);
   endArray(s);
   beginArray(s, "Float64", "force", 3);
-  for (std::size_t k : active) put(s, c.force[k]);
+  for (std::size_t k : active) put(s, c.result[k].force);
   endArray(s);
   beginArray(s, "Float64", "overlap", 1);
-  for (std::size_t k : active) put(s, c.overlap[k]);
+  for (std::size_t k : active) put(s, c.result[k].overlap);
   endArray(s);
   s += "      </CellData>\n";
   writePoints(s, pts);

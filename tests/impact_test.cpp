@@ -44,9 +44,9 @@ ImpactResult collide(const Material& m, double R, const Vec3& v1, const Vec3& v2
     Vec3 n = Vec3::UnitX();
     for (std::size_t p = 0; p < c.size(); ++p)
       if (c.active(p)) {
-        ov = c.overlap[p];
-        n = c.normal[p];
-        r.maxForce = std::max(r.maxForce, c.normalForce[p]);
+        ov = c.result[p].overlap;
+        n = c.result[p].normal;
+        r.maxForce = std::max(r.maxForce, c.result[p].normalForce);
       }
     if (ov > 0) {
       touched = true;

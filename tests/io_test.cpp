@@ -473,7 +473,7 @@ TEST(VtkXml, LineAcrossThePeriodicBoundaryHasTheBranchLength) {
   ASSERT_EQ(c.activeCount(), 1u);
   double branch = 0.0;
   for (std::size_t k = 0; k < c.size(); ++k)
-    if (c.active(k)) branch = c.distance[k];
+    if (c.active(k)) branch = c.distance(k, sim.particles().radius);
   writeContactsVtu(dir / "contacts.vtu", sim);
   const auto pts = dataArray(slurp(dir / "contacts.vtu"), "");
   ASSERT_EQ(pts.size(), 6u);

@@ -312,9 +312,9 @@ Rebound obliqueImpact(TangentialModel model, double tanTheta, const Material& m,
     for (std::size_t q = 0; q < c.size(); ++q)
       if (c.active(q)) {
         active = true;
-        if (c.overlap[q] > maxOverlap) {
-          maxOverlap = c.overlap[q];
-          n = c.normal[q];
+        if (c.result[q].overlap > maxOverlap) {
+          maxOverlap = c.result[q].overlap;
+          n = c.result[q].normal;
         }
       }
     if (active) touched = true;

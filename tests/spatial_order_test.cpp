@@ -112,8 +112,8 @@ TEST(SpatialOrder, MemoryBytesCountsParticleAndPairArrays) {
   ASSERT_GT(pairs, 0u);
   const std::size_t perParticle = 5 * sizeof(Vec3) + 3 * sizeof(double) + sizeof(std::int32_t) +
                                   sizeof(std::uint16_t) + sizeof(Vec3i) + sizeof(Vec3);  // + reference position
-  const std::size_t perPair = 2 * sizeof(std::int32_t) + sizeof(Image) + sizeof(ContactHistory) + 2 * sizeof(Vec3) +
-                              3 * sizeof(double) + sizeof(KickTerms) + 2 * sizeof(std::int32_t);  // + adjacency
+  const std::size_t perPair = 2 * sizeof(std::int32_t) + sizeof(Image) + sizeof(ContactHistory) +
+                              sizeof(PairResult) + 2 * sizeof(std::int32_t);  // + adjacency
   const std::size_t lower = n * perParticle + pairs * perPair;
   EXPECT_GE(sim.memoryBytes(), lower);
   EXPECT_LE(sim.memoryBytes(), 2 * lower + 64 * 1024);

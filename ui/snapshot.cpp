@@ -60,9 +60,8 @@ void fillParticles(const Simulation& sim, Snapshot& out) {
     out.speeds[i] = p.vel[i].norm();
   }
   out.contacts.clear();
-  // The result arrays may be shorter than the pair list right after a rebuild; read what is there.
-  const std::size_t pairs = std::min({c.size(), c.overlap.size(), c.normal.size(), c.distance.size(),
-                                      c.normalForce.size()});
+  // The result array may be shorter than the pair list right after a rebuild; read what is there.
+  const std::size_t pairs = std::min(c.size(), c.result.size());
   out.contacts.reserve(pairs / 2);
   for (std::size_t k = 0; k < pairs; ++k) {
     if (!c.active(k)) continue;
@@ -71,15 +70,16 @@ void fillParticles(const Simulation& sim, Snapshot& out) {
     s.first = i;
     s.second = j;
     s.start = out.positions[static_cast<std::size_t>(i)];
-    s.branch = c.branch(k);
-    s.normalForce = c.normalForce[k];
+    s.branch = c.branch(k, p.radius);
+    s.normalForce = c.result[k].normalForce;
     out.contacts.push_back(s);
     ++out.contactCounts[static_cast<std::size_t>(i)];
     ++out.contactCounts[static_cast<std::size_t>(j)];
     // trace of f (x) r_c for each side: F_n times the lever arm (r - delta/2), compression positive
-    const double half = 0.5 * c.overlap[k];
-    out.meanStress[static_cast<std::size_t>(i)] += c.normalForce[k] * (p.radius[static_cast<std::size_t>(i)] - half);
-    out.meanStress[static_cast<std::size_t>(j)] += c.normalForce[k] * (p.radius[static_cast<std::size_t>(j)] - half);
+    const double half = 0.5 * c.result[k].overlap;
+    const double fn = c.result[k].normalForce;
+    out.meanStress[static_cast<std::size_t>(i)] += fn * (p.radius[static_cast<std::size_t>(i)] - half);
+    out.meanStress[static_cast<std::size_t>(j)] += fn * (p.radius[static_cast<std::size_t>(j)] - half);
   }
   for (std::size_t i = 0; i < n; ++i) {
     const double r = p.radius[i];

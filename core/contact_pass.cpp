@@ -1,0 +1,316 @@
+// Step 3 of the pipeline (simulation.hpp): the contact forces of every listed pair, written into the
+// contact store, with the Love–Weber stress, the diagnostics and (if tracked) the energies summed per fixed
+// chunk of pairs in the same pass. The default law runs vectorised over blocks of touching pairs
+// (contact_block.hpp); the Mindlin–Deresiewicz law one pair at a time (mindlin_deresiewicz.hpp).
+#include <algorithm>
+#include <cmath>
+
+#include "contact_block.hpp"
+#include "contact_kernels.hpp"
+#include "mindlin_deresiewicz.hpp"
+#include "simulation.hpp"
+
+namespace fl {
+
+void Simulation::computeContacts() {
+  // the tangential law is chosen once per pass, not per pair
+  if (m_num.tangentialModel == TangentialModel::MindlinDeresiewicz) dispatchContactPass<true>();
+  else dispatchContactPass<false>();
+}
+
+template <bool kMD>
+void Simulation::dispatchContactPass() {
+  // one instantiation per combination of optional terms: no branch on a disabled feature in the loop
+  const bool damping = m_num.restitution < 1.0;
+  const bool affine = !m_cell.velocityGradient().isZero(0.0);
+  const int mode = (m_num.trackEnergy ? 4 : 0) | (damping ? 2 : 0) | (affine ? 1 : 0);
+  switch (mode) {
+    case 0: contactPass<false, false, false, kMD>(); break;
+    case 1: contactPass<false, false, true, kMD>(); break;
+    case 2: contactPass<false, true, false, kMD>(); break;
+    case 3: contactPass<false, true, true, kMD>(); break;
+    case 4: contactPass<true, false, false, kMD>(); break;
+    case 5: contactPass<true, false, true, kMD>(); break;
+    case 6: contactPass<true, true, false, kMD>(); break;
+    default: contactPass<true, true, true, kMD>(); break;
+  }
+}
+
+void Simulation::syncTangentialHistory() {
+  if (m_num.tangentialModel != TangentialModel::MindlinDeresiewicz) {
+    // leaving the law: its locked micro-slip energy is dissipated (the ledger stays balanced)
+    if (m_num.trackEnergy)
+      for (const MdHistory& h : m_c.mdHistory) m_energy.frictionWork += h.locked;
+    m_c.mdHistory.clear();
+    m_c.mdHistory.shrink_to_fit();
+  } else if (m_c.mdHistory.size() != m_c.size()) {
+    m_c.mdHistory.assign(m_c.size(), MdHistory{});
+    for (std::size_t p = 0; p < m_c.size(); ++p) m_c.mdHistory[p].prevNormalForce = m_c.result[p].normalForce;
+  }
+}
+
+template <bool kEnergy, bool kDamping, bool kAffine, bool kMD>
+void Simulation::contactPass() {
+  if constexpr (kMD) contactPassMindlinDeresiewicz<kEnergy, kDamping, kAffine>();
+  else contactPassBlocked<kEnergy, kDamping, kAffine>();
+}
+
+template <bool kEnergy, bool kDamping, bool kAffine>
+void Simulation::contactPassBlocked() {
+  // Three phases per block of listed pairs, all within one reduction chunk (so the bits do not depend on
+  // the thread count): 1. gather the touching pairs' inputs into a PairBlock, branch-free compaction;
+  // 2. the law, vectorised across the block (kernels::hertzMindlinBlock); 3. scatter the results and
+  // history back and sum the chunk's partials in pair order.
+  static_assert(kChunk % kernels::kBlockPairs == 0, "reduction chunks hold whole blocks");
+  const std::size_t np = m_c.size();
+  const std::size_t nchunks = (np + kChunk - 1) / kChunk;
+  const Mat3& H = m_cell.matrix();
+  const Mat3& L = m_cell.velocityGradient();
+  const double dt = m_dt;
+  const Vec3* x = m_p.pos.data();
+  const Vec3* v = m_p.vel.data();
+  const Vec3* w = m_p.angVel.data();
+  const double* rad = m_p.radius.data();
+  const double* im = m_p.invMass.data();
+  const std::uint16_t* mat = m_p.material.data();
+  const std::int32_t* first = m_c.first.data();
+  const std::int32_t* second = m_c.second.data();
+  const Image* image = m_c.image.data();
+  ContactHistory* hist = m_c.history.data();
+  PairResult* result = m_c.result.data();
+  const PairTable& table = m_pairs;
+  Chunk* chunks = m_chunks.data();
+#pragma omp parallel num_threads(m_num.threads)
+  {
+    kernels::PairBlock b;  // per thread, ~23 KiB: stays in L1 through the three phases
+    std::int32_t index[kernels::kBlockPairs];       // pair of each slot
+    std::int32_t staleIndex[kernels::kBlockPairs];  // pairs whose contact opened this step
+#pragma omp for schedule(static)
+    for (std::size_t k = 0; k < nchunks; ++k) {
+      Chunk acc;
+      const std::size_t chunkEnd = std::min(np, (k + 1) * kChunk);
+      for (std::size_t p0 = k * kChunk; p0 < chunkEnd; p0 += kernels::kBlockPairs) {
+        const std::size_t p1 = std::min(chunkEnd, p0 + kernels::kBlockPairs);
+        // 1. gather: every pair is written to slot m, which advances only for a touching pair; a pair
+        // whose contact opened goes to the stale list. No branch depends on the data (40 % of the listed
+        // pairs do not touch: a branch on it was mispredicted about as often).
+        int m = 0, stale = 0;
+        for (std::size_t p = p0; p < p1; ++p) {
+          const int i = first[p], j = second[p];
+          Vec3 d = x[j] - x[i];
+          const Image img = image[p];
+          if (!img.isZero()) d += H * img.vec().cast<double>();
+          const double ri = rad[i], rj = rad[j];
+          const double R = ri + rj;
+          const double dist2 = d.squaredNorm();
+          const int touching = dist2 < R * R;
+          const ContactHistory& h = hist[p];
+          // a touching pair always has a > 0 in its history, and its results are only ever non-zero with
+          // it (a rebuild zeroes the results but carries the history), so the history alone tells
+          staleIndex[stale] = static_cast<std::int32_t>(p);
+          stale += static_cast<int>(h.contactRadius != 0.0) & (touching ^ 1);
+          // relative velocity of the centres, with the mean field L·d, which carries the image shift
+          // velocity L·H·n for pairs across the boundary (verification ladder §2)
+          Vec3 vr = v[j] - v[i];
+          if constexpr (kAffine) vr += L * d;
+          const PairParams& pp = table(mat[i], mat[j]);
+          index[m] = static_cast<std::int32_t>(p);
+          b.dx[m] = d.x(), b.dy[m] = d.y(), b.dz[m] = d.z();
+          b.dist2[m] = dist2;
+          b.ri[m] = ri, b.rj[m] = rj;
+          b.vx[m] = vr.x(), b.vy[m] = vr.y(), b.vz[m] = vr.z();
+          b.wix[m] = w[i].x(), b.wiy[m] = w[i].y(), b.wiz[m] = w[i].z();
+          b.wjx[m] = w[j].x(), b.wjy[m] = w[j].y(), b.wjz[m] = w[j].z();
+          b.invMassSum[m] = im[i] + im[j];
+          b.effYoung[m] = pp.effYoung, b.effShear[m] = pp.effShear;
+          b.friction[m] = pp.friction, b.dampingRatio[m] = pp.dampingRatio;
+          b.tx[m] = h.tangentialForce.x(), b.ty[m] = h.tangentialForce.y(), b.tz[m] = h.tangentialForce.z();
+          b.aPrev[m] = h.contactRadius;
+          m += touching;
+        }
+        // the contacts that opened: results and history are zero (the kick gathers the zero force as is)
+        for (int s = 0; s < stale; ++s) {
+          result[staleIndex[s]] = PairResult{};
+          hist[staleIndex[s]] = ContactHistory{};
+        }
+        b.count = m;
+        // 2. the law across the block
+        kernels::hertzMindlinBlock<kDamping>(b, dt);
+        // 3. scatter, and the chunk's sums in pair order
+        for (int s = 0; s < m; ++s) {
+          const std::size_t p = static_cast<std::size_t>(index[s]);
+          const Vec3 n(b.nx[s], b.ny[s], b.nz[s]);
+          const Vec3 f(b.fx[s], b.fy[s], b.fz[s]);
+          const Vec3 d(b.dx[s], b.dy[s], b.dz[s]);
+          hist[p].tangentialForce = Vec3(b.tx[s], b.ty[s], b.tz[s]);
+          hist[p].contactRadius = b.aPrev[s];
+          result[p] = {f, n, b.delta[s], b.fn[s]};
+          acc.stress.noalias() += f * d.transpose();
+          acc.stiffness += b.kn[s] * n.cwiseProduct(d).cwiseAbs2();
+          acc.sumForce += b.fnorm[s];
+          acc.sliding += b.sliding[s] != 0.0;
+          acc.maxOverlapRatio = std::max(acc.maxOverlapRatio, b.overlapRatio[s]);
+          acc.maxKOverM = std::max(acc.maxKOverM, b.kOverM[s]);
+          if constexpr (kEnergy) {
+            acc.elasticN += b.elasticN[s];
+            acc.elasticT += b.storedT[s];
+            acc.friction += b.dissipatedT[s];
+            acc.damping += b.dampPower[s] * dt;
+          }
+        }
+        acc.contacts += static_cast<std::size_t>(m);
+      }
+      chunks[k] = acc;
+    }
+  }
+  reduceContactChunks<kEnergy>(nchunks);
+}
+
+template <bool kEnergy, bool kDamping, bool kAffine>
+void Simulation::contactPassMindlinDeresiewicz() {
+
+  const std::size_t np = m_c.size();
+  const std::size_t nchunks = (np + kChunk - 1) / kChunk;
+  const Mat3& H = m_cell.matrix();
+  const Mat3& L = m_cell.velocityGradient();
+  const double dt = m_dt;
+  const Vec3* x = m_p.pos.data();
+  const Vec3* v = m_p.vel.data();
+  const Vec3* w = m_p.angVel.data();
+  const double* rad = m_p.radius.data();
+  const double* im = m_p.invMass.data();
+  const std::uint16_t* mat = m_p.material.data();
+  const std::int32_t* first = m_c.first.data();
+  const std::int32_t* second = m_c.second.data();
+  const Image* image = m_c.image.data();
+  ContactHistory* hist = m_c.history.data();
+  MdHistory* mdHist = m_c.mdHistory.data();
+  PairResult* result = m_c.result.data();
+  const PairTable& table = m_pairs;
+  Chunk* chunks = m_chunks.data();
+#pragma omp parallel for num_threads(m_num.threads) schedule(static)
+  for (std::size_t k = 0; k < nchunks; ++k) {
+    Chunk acc;
+    const std::size_t end = std::min(np, (k + 1) * kChunk);
+    for (std::size_t p = k * kChunk; p < end; ++p) {
+      const int i = first[p], j = second[p];
+      Vec3 d = x[j] - x[i];
+      const Image img = image[p];
+      if (!img.isZero()) d += H * img.vec().cast<double>();
+      const double ri = rad[i], rj = rad[j];
+      const double R = ri + rj;
+      const double dist2 = d.squaredNorm();
+      if (dist2 >= R * R) {
+        // not touching: results and history are zero (the kick gathers the zero force unconditionally)
+        if (hist[p].contactRadius != 0.0) {  // a touching pair always has a > 0 (see contactPassBlocked)
+          result[p] = PairResult{};
+          hist[p] = ContactHistory{};
+          // the contact opened: its locked micro-slip energy is dissipated
+          if constexpr (kEnergy) acc.friction += mdHist[p].locked;
+          mdHist[p] = MdHistory{};
+        }
+        continue;
+      }
+      const double dist = std::sqrt(dist2);
+      const double invDist = 1.0 / dist;
+      const Vec3 n = d * invDist;
+      const double delta = R - dist;
+      const double li = ri - 0.5 * delta, lj = rj - 0.5 * delta;
+      // relative velocity of j's contact point w.r.t. i's, including the mean field L·l, which carries the
+      // image shift velocity L·H·n for pairs across the boundary (verification ladder §2)
+      Vec3 vrel = v[j] - v[i] - (lj * w[j] + li * w[i]).cross(n);
+      if constexpr (kAffine) vrel += L * d;
+      const double vn = vrel.dot(n);
+      const Vec3 vt = vrel - vn * n;
+      const PairParams& pp = table(mat[i], mat[j]);
+      const double Rstar = ri * rj / R;
+      const double a = std::sqrt(Rstar * delta);
+      const double fe = kernels::hertzForce(pp.effYoung, a, delta);
+      double fn = fe;
+      const double kn = kernels::hertzStiffness(pp.effYoung, a);
+      double dampPower = 0.0;
+      double mstar = 0.0;
+      if constexpr (kDamping) {
+        mstar = 1.0 / (im[i] + im[j]);
+        const double cn = kernels::dampingCoefficient(pp.dampingRatio, kn, mstar);
+        fn = std::max(0.0, fe - cn * vn);  // no attraction
+        dampPower += (fe - fn) * vn;       // = cn vn^2 unless clamped
+      }
+      // tangential law: elastic force, stiffness k_t (time step, damping), stored energy and dissipation
+      Vec3 ftElastic;
+      double kt, storedT, dissipatedT;
+      bool sliding;
+      {
+        const auto tr = kernels::mindlinDeresiewicz(n, vt, a, fn, pp.effShear, pp.friction, dt, hist[p], mdHist[p]);
+        ftElastic = tr.force;
+        kt = tr.stiffness;
+        sliding = tr.sliding;
+        storedT = tr.storedEnergy;
+        dissipatedT = tr.slipWork + tr.microSlipWork;
+      }
+      Vec3 ft = ftElastic;
+      if constexpr (kDamping) {
+        if (!sliding) {
+          const Vec3 fd = -kernels::dampingCoefficient(pp.dampingRatio, kt, mstar) * vt;
+          ft += fd;
+          dampPower -= fd.dot(vt);
+        }
+      }
+      const Vec3 f = fn * n + ft;
+      result[p] = {f, n, delta, fn};
+      acc.stress.noalias() += f * d.transpose();
+      acc.stiffness += kn * n.cwiseProduct(d).cwiseAbs2();
+      acc.sumForce += f.norm();
+      ++acc.contacts;
+      acc.sliding += sliding;
+      acc.maxOverlapRatio = std::max(acc.maxOverlapRatio, delta / std::min(ri, rj));
+      acc.maxKOverM = std::max(acc.maxKOverM, std::max(kn, 3.5 * kt) * (im[i] + im[j]));
+      if constexpr (kEnergy) {
+        acc.elasticN += kernels::hertzEnergy(fe, delta);
+        acc.elasticT += storedT;
+        acc.friction += dissipatedT;
+        acc.damping += dampPower * dt;
+      }
+    }
+    chunks[k] = acc;
+  }
+  reduceContactChunks<kEnergy>(nchunks);
+}
+
+template <bool kEnergy>
+void Simulation::reduceContactChunks(std::size_t nchunks) {
+  Mat3 s = Mat3::Zero();
+  double eN = 0.0, eT = 0.0, fr = 0.0, dm = 0.0, sf = 0.0, mo = 0.0, mk = 0.0;
+  Vec3 stiff = Vec3::Zero();
+  std::size_t nc = 0, ns = 0;
+  for (std::size_t k = 0; k < nchunks; ++k) {
+    const Chunk& a = m_chunks[k];
+    s += a.stress;
+    stiff += a.stiffness;
+    eN += a.elasticN;
+    eT += a.elasticT;
+    fr += a.friction;
+    dm += a.damping;
+    sf += a.sumForce;
+    nc += a.contacts;
+    ns += a.sliding;
+    mo = std::max(mo, a.maxOverlapRatio);
+    mk = std::max(mk, a.maxKOverM);
+  }
+  m_stressPrev = m_stress;
+  m_stress = s / m_cell.volume();
+  if constexpr (kEnergy) {
+    m_energy.elasticNormal = eN;
+    m_energy.elasticTangential = eT;
+    m_energy.frictionWork += fr;
+    m_energy.contactDampingWork += dm;
+  }
+  m_diag.contacts = nc;
+  m_diag.sliding = ns;
+  m_diag.meanContactForce = nc ? sf / static_cast<double>(nc) : 0.0;
+  m_diag.maxOverlapRatio = mo;
+  m_diag.maxStiffnessOverMass = mk;
+  m_diag.axisStiffness = stiff / m_cell.volume();
+}
+
+}  // namespace fl
