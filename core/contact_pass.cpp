@@ -58,7 +58,7 @@ void Simulation::contactPass() {
 template <bool kEnergy, bool kDamping, bool kAffine>
 void Simulation::contactPassBlocked() {
   // Three phases per block of listed pairs, all within one reduction chunk (so the bits do not depend on
-  // the thread count): 1. gather the touching pairs' inputs into a PairBlock, branch-free compaction;
+  // the thread count): 1. gather the touching pairs' inputs into a PairBlock (branch-free compaction);
   // 2. the law, vectorised across the block (kernels::hertzMindlinBlock); 3. scatter the results and
   // history back and sum the chunk's partials in pair order.
   static_assert(kChunk % kernels::kBlockPairs == 0, "reduction chunks hold whole blocks");
@@ -91,9 +91,9 @@ void Simulation::contactPassBlocked() {
       const std::size_t chunkEnd = std::min(np, (k + 1) * kChunk);
       for (std::size_t p0 = k * kChunk; p0 < chunkEnd; p0 += kernels::kBlockPairs) {
         const std::size_t p1 = std::min(chunkEnd, p0 + kernels::kBlockPairs);
-        // 1. gather: every pair is written to slot m, which advances only for a touching pair; a pair
-        // whose contact opened goes to the stale list. No branch depends on the data (40 % of the listed
-        // pairs do not touch: a branch on it was mispredicted about as often).
+        // 1a. geometry of every listed pair: each is written to slot m, which advances only for a touching
+        // pair; a pair whose contact opened goes to the stale list. No branch depends on the data (40 % of
+        // the listed pairs do not touch: a branch on it was mispredicted about as often).
         int m = 0, stale = 0;
         for (std::size_t p = p0; p < p1; ++p) {
           const int i = first[p], j = second[p];
@@ -104,29 +104,34 @@ void Simulation::contactPassBlocked() {
           const double R = ri + rj;
           const double dist2 = d.squaredNorm();
           const int touching = dist2 < R * R;
-          const ContactHistory& h = hist[p];
           // a touching pair always has a > 0 in its history, and its results are only ever non-zero with
           // it (a rebuild zeroes the results but carries the history), so the history alone tells
           staleIndex[stale] = static_cast<std::int32_t>(p);
-          stale += static_cast<int>(h.contactRadius != 0.0) & (touching ^ 1);
-          // relative velocity of the centres, with the mean field L·d, which carries the image shift
-          // velocity L·H·n for pairs across the boundary (verification ladder §2)
-          Vec3 vr = v[j] - v[i];
-          if constexpr (kAffine) vr += L * d;
-          const PairParams& pp = table(mat[i], mat[j]);
+          stale += static_cast<int>(hist[p].contactRadius != 0.0) & (touching ^ 1);
           index[m] = static_cast<std::int32_t>(p);
           b.dx[m] = d.x(), b.dy[m] = d.y(), b.dz[m] = d.z();
           b.dist2[m] = dist2;
           b.ri[m] = ri, b.rj[m] = rj;
-          b.vx[m] = vr.x(), b.vy[m] = vr.y(), b.vz[m] = vr.z();
-          b.wix[m] = w[i].x(), b.wiy[m] = w[i].y(), b.wiz[m] = w[i].z();
-          b.wjx[m] = w[j].x(), b.wjy[m] = w[j].y(), b.wjz[m] = w[j].z();
-          b.invMassSum[m] = im[i] + im[j];
-          b.effYoung[m] = pp.effYoung, b.effShear[m] = pp.effShear;
-          b.friction[m] = pp.friction, b.dampingRatio[m] = pp.dampingRatio;
-          b.tx[m] = h.tangentialForce.x(), b.ty[m] = h.tangentialForce.y(), b.tz[m] = h.tangentialForce.z();
-          b.aPrev[m] = h.contactRadius;
           m += touching;
+        }
+        // 1b. the rest of the inputs, for the touching pairs only
+        for (int s = 0; s < m; ++s) {
+          const std::size_t p = static_cast<std::size_t>(index[s]);
+          const int i = first[p], j = second[p];
+          // relative velocity of the centres, with the mean field L·d, which carries the image shift
+          // velocity L·H·n for pairs across the boundary (verification ladder §2)
+          Vec3 vr = v[j] - v[i];
+          if constexpr (kAffine) vr += L * Vec3(b.dx[s], b.dy[s], b.dz[s]);
+          const PairParams& pp = table(mat[i], mat[j]);
+          const ContactHistory& h = hist[p];
+          b.vx[s] = vr.x(), b.vy[s] = vr.y(), b.vz[s] = vr.z();
+          b.wix[s] = w[i].x(), b.wiy[s] = w[i].y(), b.wiz[s] = w[i].z();
+          b.wjx[s] = w[j].x(), b.wjy[s] = w[j].y(), b.wjz[s] = w[j].z();
+          b.invMassSum[s] = im[i] + im[j];
+          b.effYoung[s] = pp.effYoung, b.effShear[s] = pp.effShear;
+          b.friction[s] = pp.friction, b.dampingRatio[s] = pp.dampingRatio;
+          b.tx[s] = h.tangentialForce.x(), b.ty[s] = h.tangentialForce.y(), b.tz[s] = h.tangentialForce.z();
+          b.aPrev[s] = h.contactRadius;
         }
         // the contacts that opened: results and history are zero (the kick gathers the zero force as is)
         for (int s = 0; s < stale; ++s) {
