@@ -12,6 +12,34 @@
 
 namespace fl {
 
+namespace {
+// The arrays both contact passes read and write, as plain pointers for the OpenMP loops.
+struct PassArrays {
+  const Vec3* x;    // positions
+  const Vec3* v;    // fluctuating velocities
+  const Vec3* w;    // angular velocities
+  const double* rad;
+  const double* im;  // 1/m
+  const std::uint16_t* mat;
+  const std::int32_t* first;
+  const std::int32_t* second;
+  const Image* image;
+  ContactHistory* hist;
+  PairResult* result;
+  PassArrays(const ParticleStore& p, ContactStore& c)
+      : x(p.pos.data()), v(p.vel.data()), w(p.angVel.data()), rad(p.radius.data()), im(p.invMass.data()),
+        mat(p.material.data()), first(c.first.data()), second(c.second.data()), image(c.image.data()),
+        hist(c.history.data()), result(c.result.data()) {}
+  // l = x_j + H image - x_i: the branch vector from i to the periodic image of j that pair p couples
+  Vec3 branch(std::size_t p, int i, int j, const Mat3& H) const {
+    Vec3 d = x[j] - x[i];
+    const Image img = image[p];
+    if (!img.isZero()) d += H * img.vec().cast<double>();
+    return d;
+  }
+};
+}  // namespace
+
 void Simulation::computeContacts() {
   // the tangential law is chosen once per pass, not per pair
   if (m_num.tangentialModel == TangentialModel::MindlinDeresiewicz) dispatchContactPass<true>();
@@ -67,17 +95,7 @@ void Simulation::contactPassBlocked() {
   const Mat3& H = m_cell.matrix();
   const Mat3& L = m_cell.velocityGradient();
   const double dt = m_dt;
-  const Vec3* x = m_p.pos.data();
-  const Vec3* v = m_p.vel.data();
-  const Vec3* w = m_p.angVel.data();
-  const double* rad = m_p.radius.data();
-  const double* im = m_p.invMass.data();
-  const std::uint16_t* mat = m_p.material.data();
-  const std::int32_t* first = m_c.first.data();
-  const std::int32_t* second = m_c.second.data();
-  const Image* image = m_c.image.data();
-  ContactHistory* hist = m_c.history.data();
-  PairResult* result = m_c.result.data();
+  const PassArrays arr(m_p, m_c);
   const PairTable& table = m_pairs;
   Chunk* chunks = m_chunks.data();
 #pragma omp parallel num_threads(m_num.threads)
@@ -96,18 +114,16 @@ void Simulation::contactPassBlocked() {
         // the listed pairs do not touch: a branch on it was mispredicted about as often).
         int m = 0, stale = 0;
         for (std::size_t p = p0; p < p1; ++p) {
-          const int i = first[p], j = second[p];
-          Vec3 d = x[j] - x[i];
-          const Image img = image[p];
-          if (!img.isZero()) d += H * img.vec().cast<double>();
-          const double ri = rad[i], rj = rad[j];
+          const int i = arr.first[p], j = arr.second[p];
+          const Vec3 d = arr.branch(p, i, j, H);
+          const double ri = arr.rad[i], rj = arr.rad[j];
           const double R = ri + rj;
           const double dist2 = d.squaredNorm();
           const int touching = dist2 < R * R;
           // a touching pair always has a > 0 in its history, and its results are only ever non-zero with
           // it (a rebuild zeroes the results but carries the history), so the history alone tells
           staleIndex[stale] = static_cast<std::int32_t>(p);
-          stale += static_cast<int>(hist[p].contactRadius != 0.0) & (touching ^ 1);
+          stale += static_cast<int>(arr.hist[p].contactRadius != 0.0) & (touching ^ 1);
           index[m] = static_cast<std::int32_t>(p);
           b.dx[m] = d.x(), b.dy[m] = d.y(), b.dz[m] = d.z();
           b.dist2[m] = dist2;
@@ -117,17 +133,17 @@ void Simulation::contactPassBlocked() {
         // 1b. the rest of the inputs, for the touching pairs only
         for (int s = 0; s < m; ++s) {
           const std::size_t p = static_cast<std::size_t>(index[s]);
-          const int i = first[p], j = second[p];
+          const int i = arr.first[p], j = arr.second[p];
           // relative velocity of the centres, with the mean field L·d, which carries the image shift
           // velocity L·H·n for pairs across the boundary (verification ladder §2)
-          Vec3 vr = v[j] - v[i];
+          Vec3 vr = arr.v[j] - arr.v[i];
           if constexpr (kAffine) vr += L * Vec3(b.dx[s], b.dy[s], b.dz[s]);
-          const PairParams& pp = table(mat[i], mat[j]);
-          const ContactHistory& h = hist[p];
+          const PairParams& pp = table(arr.mat[i], arr.mat[j]);
+          const ContactHistory& h = arr.hist[p];
           b.vx[s] = vr.x(), b.vy[s] = vr.y(), b.vz[s] = vr.z();
-          b.wix[s] = w[i].x(), b.wiy[s] = w[i].y(), b.wiz[s] = w[i].z();
-          b.wjx[s] = w[j].x(), b.wjy[s] = w[j].y(), b.wjz[s] = w[j].z();
-          b.invMassSum[s] = im[i] + im[j];
+          b.wix[s] = arr.w[i].x(), b.wiy[s] = arr.w[i].y(), b.wiz[s] = arr.w[i].z();
+          b.wjx[s] = arr.w[j].x(), b.wjy[s] = arr.w[j].y(), b.wjz[s] = arr.w[j].z();
+          b.invMassSum[s] = arr.im[i] + arr.im[j];
           b.effYoung[s] = pp.effYoung, b.effShear[s] = pp.effShear;
           b.friction[s] = pp.friction, b.dampingRatio[s] = pp.dampingRatio;
           b.tx[s] = h.tangentialForce.x(), b.ty[s] = h.tangentialForce.y(), b.tz[s] = h.tangentialForce.z();
@@ -135,8 +151,8 @@ void Simulation::contactPassBlocked() {
         }
         // the contacts that opened: results and history are zero (the kick gathers the zero force as is)
         for (int s = 0; s < stale; ++s) {
-          result[staleIndex[s]] = PairResult{};
-          hist[staleIndex[s]] = ContactHistory{};
+          arr.result[staleIndex[s]] = PairResult{};
+          arr.hist[staleIndex[s]] = ContactHistory{};
         }
         b.count = m;
         // 2. the law across the block
@@ -147,9 +163,9 @@ void Simulation::contactPassBlocked() {
           const Vec3 n(b.nx[s], b.ny[s], b.nz[s]);
           const Vec3 f(b.fx[s], b.fy[s], b.fz[s]);
           const Vec3 d(b.dx[s], b.dy[s], b.dz[s]);
-          hist[p].tangentialForce = Vec3(b.tx[s], b.ty[s], b.tz[s]);
-          hist[p].contactRadius = b.aPrev[s];
-          result[p] = {f, n, b.delta[s], b.fn[s]};
+          arr.hist[p].tangentialForce = Vec3(b.tx[s], b.ty[s], b.tz[s]);
+          arr.hist[p].contactRadius = b.aPrev[s];
+          arr.result[p] = {f, n, b.delta[s], b.fn[s]};
           acc.stress.noalias() += f * d.transpose();
           acc.stiffness += b.kn[s] * n.cwiseProduct(d).cwiseAbs2();
           acc.sumForce += b.fnorm[s];
@@ -173,24 +189,13 @@ void Simulation::contactPassBlocked() {
 
 template <bool kEnergy, bool kDamping, bool kAffine>
 void Simulation::contactPassMindlinDeresiewicz() {
-
   const std::size_t np = m_c.size();
   const std::size_t nchunks = (np + kChunk - 1) / kChunk;
   const Mat3& H = m_cell.matrix();
   const Mat3& L = m_cell.velocityGradient();
   const double dt = m_dt;
-  const Vec3* x = m_p.pos.data();
-  const Vec3* v = m_p.vel.data();
-  const Vec3* w = m_p.angVel.data();
-  const double* rad = m_p.radius.data();
-  const double* im = m_p.invMass.data();
-  const std::uint16_t* mat = m_p.material.data();
-  const std::int32_t* first = m_c.first.data();
-  const std::int32_t* second = m_c.second.data();
-  const Image* image = m_c.image.data();
-  ContactHistory* hist = m_c.history.data();
+  const PassArrays arr(m_p, m_c);
   MdHistory* mdHist = m_c.mdHistory.data();
-  PairResult* result = m_c.result.data();
   const PairTable& table = m_pairs;
   Chunk* chunks = m_chunks.data();
 #pragma omp parallel for num_threads(m_num.threads) schedule(static)
@@ -198,18 +203,16 @@ void Simulation::contactPassMindlinDeresiewicz() {
     Chunk acc;
     const std::size_t end = std::min(np, (k + 1) * kChunk);
     for (std::size_t p = k * kChunk; p < end; ++p) {
-      const int i = first[p], j = second[p];
-      Vec3 d = x[j] - x[i];
-      const Image img = image[p];
-      if (!img.isZero()) d += H * img.vec().cast<double>();
-      const double ri = rad[i], rj = rad[j];
+      const int i = arr.first[p], j = arr.second[p];
+      const Vec3 d = arr.branch(p, i, j, H);
+      const double ri = arr.rad[i], rj = arr.rad[j];
       const double R = ri + rj;
       const double dist2 = d.squaredNorm();
       if (dist2 >= R * R) {
         // not touching: results and history are zero (the kick gathers the zero force unconditionally)
-        if (hist[p].contactRadius != 0.0) {  // a touching pair always has a > 0 (see contactPassBlocked)
-          result[p] = PairResult{};
-          hist[p] = ContactHistory{};
+        if (arr.hist[p].contactRadius != 0.0) {  // a touching pair always has a > 0 (see contactPassBlocked)
+          arr.result[p] = PairResult{};
+          arr.hist[p] = ContactHistory{};
           // the contact opened: its locked micro-slip energy is dissipated
           if constexpr (kEnergy) acc.friction += mdHist[p].locked;
           mdHist[p] = MdHistory{};
@@ -223,11 +226,11 @@ void Simulation::contactPassMindlinDeresiewicz() {
       const double li = ri - 0.5 * delta, lj = rj - 0.5 * delta;
       // relative velocity of j's contact point w.r.t. i's, including the mean field L·l, which carries the
       // image shift velocity L·H·n for pairs across the boundary (verification ladder §2)
-      Vec3 vrel = v[j] - v[i] - (lj * w[j] + li * w[i]).cross(n);
+      Vec3 vrel = arr.v[j] - arr.v[i] - (lj * arr.w[j] + li * arr.w[i]).cross(n);
       if constexpr (kAffine) vrel += L * d;
       const double vn = vrel.dot(n);
       const Vec3 vt = vrel - vn * n;
-      const PairParams& pp = table(mat[i], mat[j]);
+      const PairParams& pp = table(arr.mat[i], arr.mat[j]);
       const double Rstar = ri * rj / R;
       const double a = std::sqrt(Rstar * delta);
       const double fe = kernels::hertzForce(pp.effYoung, a, delta);
@@ -236,7 +239,7 @@ void Simulation::contactPassMindlinDeresiewicz() {
       double dampPower = 0.0;
       double mstar = 0.0;
       if constexpr (kDamping) {
-        mstar = 1.0 / (im[i] + im[j]);
+        mstar = 1.0 / (arr.im[i] + arr.im[j]);
         const double cn = kernels::dampingCoefficient(pp.dampingRatio, kn, mstar);
         fn = std::max(0.0, fe - cn * vn);  // no attraction
         dampPower += (fe - fn) * vn;       // = cn vn^2 unless clamped
@@ -246,7 +249,7 @@ void Simulation::contactPassMindlinDeresiewicz() {
       double kt, storedT, dissipatedT;
       bool sliding;
       {
-        const auto tr = kernels::mindlinDeresiewicz(n, vt, a, fn, pp.effShear, pp.friction, dt, hist[p], mdHist[p]);
+        const auto tr = kernels::mindlinDeresiewicz(n, vt, a, fn, pp.effShear, pp.friction, dt, arr.hist[p], mdHist[p]);
         ftElastic = tr.force;
         kt = tr.stiffness;
         sliding = tr.sliding;
@@ -262,14 +265,14 @@ void Simulation::contactPassMindlinDeresiewicz() {
         }
       }
       const Vec3 f = fn * n + ft;
-      result[p] = {f, n, delta, fn};
+      arr.result[p] = {f, n, delta, fn};
       acc.stress.noalias() += f * d.transpose();
       acc.stiffness += kn * n.cwiseProduct(d).cwiseAbs2();
       acc.sumForce += f.norm();
       ++acc.contacts;
       acc.sliding += sliding;
       acc.maxOverlapRatio = std::max(acc.maxOverlapRatio, delta / std::min(ri, rj));
-      acc.maxKOverM = std::max(acc.maxKOverM, std::max(kn, 3.5 * kt) * (im[i] + im[j]));
+      acc.maxKOverM = std::max(acc.maxKOverM, std::max(kn, 3.5 * kt) * (arr.im[i] + arr.im[j]));
       if constexpr (kEnergy) {
         acc.elasticN += kernels::hertzEnergy(fe, delta);
         acc.elasticT += storedT;
