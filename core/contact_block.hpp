@@ -16,7 +16,13 @@ namespace fl::kernels {
 
 // Pairs per block: ~40 arrays of 64 doubles (20 KiB) stay in L1 while the block is processed.
 constexpr int kBlockPairs = 64;
+// The law runs over the count rounded up to this many slots (one AVX-512 vector of doubles), so no pair
+// falls to a scalar remainder loop, which g++ does not always vectorise.
+constexpr int kSimdSlots = 8;
+static_assert(kBlockPairs % kSimdSlots == 0, "padded counts stay within the block");
 
+// Create it value-initialised (PairBlock b{}): the slots past count run through the law as padding, so they
+// must hold determinate values (zeros, or an earlier block's pairs); their results are ignored.
 struct alignas(64) PairBlock {
   int count = 0;  // touching pairs held, <= kBlockPairs
   // ---- inputs, gathered by the caller
@@ -47,9 +53,11 @@ struct alignas(64) PairBlock {
 
 // Hertz normal force, Tsuji damping (kDamping) and the incremental Mindlin no-slip spring with Coulomb cap,
 // for b.count pairs. See contact_kernels.hpp for the law and its energy bookkeeping (Thornton et al. 2011).
-template <bool kDamping>
+// kEnergy: also write the energy terms (elasticN, storedT, dissipatedT, dampPower); without it they are left
+// unwritten, and what only they need (the compliance 1/k_t among it) is dead code the compiler removes.
+template <bool kDamping, bool kEnergy>
 inline void hertzMindlinBlock(PairBlock& b, double dt) {
-  const int m = b.count;
+  const int m = (b.count + kSimdSlots - 1) / kSimdSlots * kSimdSlots;  // padding: see kSimdSlots
 #pragma omp simd
   for (int s = 0; s < m; ++s) {
     const double d = std::sqrt(b.dist2[s]);
@@ -84,7 +92,7 @@ inline void hertzMindlinBlock(PairBlock& b, double dt) {
     // Mindlin no-slip spring (mindlinNoSlip): 1. rotate into the tangent plane, 2. scale on unloading,
     // 3. increment, 4. Coulomb cap
     const double kt = mindlinStiffness(b.effShear[s], a);
-    const double compliance = kt > 0.0 ? 1.0 / (kt > 0.0 ? kt : 1.0) : 0.0;
+    const double compliance = kt > 0.0 ? 1.0 / (kt > 0.0 ? kt : 1.0) : 0.0;  // energy terms only
     double tx = b.tx[s], ty = b.ty[s], tz = b.tz[s];
     const double old2 = tx * tx + ty * ty + tz * tz;
     const double proj = tx * nx + ty * ny + tz * nz;
@@ -145,10 +153,14 @@ inline void hertzMindlinBlock(PairBlock& b, double dt) {
     b.fnorm[s] = std::sqrt(fx * fx + fy * fy + fz * fz);
     b.overlapRatio[s] = delta / std::min(ri, rj);
     b.sliding[s] = slide ? 1.0 : 0.0;
-    b.elasticN[s] = hertzEnergy(fe, delta);
-    b.storedT[s] = (tx * tx + ty * ty + tz * tz) * (0.5 * compliance);
-    b.dissipatedT[s] = slipWork + stiffnessWork;
-    b.dampPower[s] = dampPower;
+    // the energy terms stay computed in place above: g++ 12 stopped vectorising the loop when they were moved
+    // into this block
+    if constexpr (kEnergy) {
+      b.elasticN[s] = hertzEnergy(fe, delta);
+      b.storedT[s] = (tx * tx + ty * ty + tz * tz) * (0.5 * compliance);
+      b.dissipatedT[s] = slipWork + stiffnessWork;
+      b.dampPower[s] = dampPower;
+    }
   }
 }
 

@@ -100,7 +100,7 @@ void Simulation::contactPassBlocked() {
   Chunk* chunks = m_chunks.data();
 #pragma omp parallel num_threads(m_num.threads)
   {
-    kernels::PairBlock b;  // per thread, ~23 KiB: stays in L1 through the three phases
+    kernels::PairBlock b{};  // per thread, ~23 KiB: stays in L1 through the three phases
     std::int32_t index[kernels::kBlockPairs];       // pair of each slot
     std::int32_t staleIndex[kernels::kBlockPairs];  // pairs whose contact opened this step
 #pragma omp for schedule(static)
@@ -156,7 +156,7 @@ void Simulation::contactPassBlocked() {
         }
         b.count = m;
         // 2. the law across the block
-        kernels::hertzMindlinBlock<kDamping>(b, dt);
+        kernels::hertzMindlinBlock<kDamping, kEnergy>(b, dt);
         // 3. scatter, and the chunk's sums in pair order
         for (int s = 0; s < m; ++s) {
           const std::size_t p = static_cast<std::size_t>(index[s]);
