@@ -115,6 +115,14 @@ void Simulation::contactPassBlocked() {
         int m = 0, stale = 0;
         for (std::size_t p = p0; p < p1; ++p) {
           const int i = arr.first[p], j = arr.second[p];
+          // prefetch the next block's partner particles: on this kind of VM a line last written by the other
+          // core (the partners across the threads' boundary) arrives ~200 ns late (docs/performance.md)
+          if (p + kernels::kBlockPairs < np) {
+            const int jn = arr.second[p + kernels::kBlockPairs];
+            __builtin_prefetch(arr.x + jn);
+            __builtin_prefetch(arr.v + jn);
+            __builtin_prefetch(arr.w + jn);
+          }
           const Vec3 d = arr.branch(p, i, j, H);
           const double ri = arr.rad[i], rj = arr.rad[j];
           const double R = ri + rj;

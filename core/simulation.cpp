@@ -142,6 +142,11 @@ void Simulation::drift() {
   double maxd2 = 0.0;
 #pragma omp parallel for num_threads(m_num.threads) schedule(static) reduction(max : maxd2)
   for (int i = 0; i < n; ++i) {
+    if (i + kPrefetchAhead < n) {
+      __builtin_prefetch(x + i + kPrefetchAhead, 1);
+      __builtin_prefetch(v + i + kPrefetchAhead, 1);
+      __builtin_prefetch(w + i + kPrefetchAhead, 1);
+    }
     Vec3 f = F[i], t = T[i];
     if (alpha > 0.0) {
       for (int k = 0; k < 3; ++k) {
@@ -251,6 +256,9 @@ void Simulation::kickPass() {
       // store-forwarding stall on the loop-carried torque (kick 5x slower).
       const double ri = rad[i];
       double fx = 0.0, fy = 0.0, fz = 0.0, tx = 0.0, ty = 0.0, tz = 0.0;
+      if (i + kPrefetchAhead < n)
+        for (int e = adjStart[i + kPrefetchAhead]; e < adjStart[i + kPrefetchAhead + 1]; ++e)
+          __builtin_prefetch(res + (adjEntry[e] >> 1));
       for (int e = adjStart[i]; e < adjStart[i + 1]; ++e) {
         const int entry = adjEntry[e];
         const PairResult& c = res[entry >> 1];

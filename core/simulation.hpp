@@ -175,6 +175,9 @@ class Simulation {
   // Fixed reduction block (pairs or particles): results are independent of the thread count. Small enough
   // that 2 threads share ~60 blocks of a 4000-sphere packing evenly, large enough to amortise a block's sums.
   static constexpr std::size_t kChunk = 256;
+  // How far ahead (particles) the drift and the kick prefetch the lines they will write or gather: lines last
+  // written by the other core arrive ~200 ns late on this kind of VM (docs/performance.md).
+  static constexpr int kPrefetchAhead = 4;
   // Partial sums of one fixed block of pairs (or particles), reduced in block order.
   struct Chunk {
     Mat3 stress = Mat3::Zero();  // sum f (x) l [N m]
