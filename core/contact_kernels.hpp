@@ -59,6 +59,9 @@ struct TangentialResult {
 // History is updated in place. v_t is the tangential velocity of j's contact point relative to i's.
 // Cost: one division and one square root for the rotation, one division for a/a_prev, one for 1/k_t
 // (the energy terms only; dropped by the compiler when the caller ignores them).
+// The engine runs this law vectorised across pairs (kernels::hertzMindlinBlock, contact_block.hpp); this
+// scalar form is its reference: the closed-form tests (contact_law_test.cpp) check it, and
+// contact_block_test.cpp checks the block law against it pair by pair.
 inline TangentialResult mindlinNoSlip(const Vec3& n, const Vec3& vt, double contactRadius, double normalForce,
                                       double effShear, double friction, double dt, ContactHistory& h) {
   TangentialResult r;
