@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# Interleaved A/B of two bench_dense builds on the cached 4000-sphere packing (docs/performance.md, "Method").
+# On a shared VM one binary's rate moves by up to 2x between runs minutes apart, so the two builds are run in
+# alternation, ROUNDS times each, and the script prints the median and the best rate of each per thread count.
+# Noise from other tenants only ever slows a run, so the best of many short runs is the steadiest estimate.
+#
+#   bench/ab.sh BUILD_A BUILD_B [ROUNDS=8] [STEPS=5000] [THREADS=1,2]
+#   e.g. bench/ab.sh /tmp/base/build build 10
+set -euo pipefail
+a=${1:?usage: bench/ab.sh BUILD_A BUILD_B [ROUNDS] [STEPS] [THREADS]}
+b=${2:?usage: bench/ab.sh BUILD_A BUILD_B [ROUNDS] [STEPS] [THREADS]}
+rounds=${3:-8}
+steps=${4:-5000}
+threads=${5:-1,2}
+here=$(cd "$(dirname "$0")/.." && pwd)
+cache=${FL_BENCH_CACHE:-$here/build/bench-cache/dense4000_318kPa.state}
+for d in "$a" "$b"; do
+  [[ -x $d/bench/bench_dense ]] || { echo "bench/ab.sh: no $d/bench/bench_dense (build the bench_dense target)" >&2; exit 2; }
+done
+[[ -f $cache ]] || { echo "bench/ab.sh: no cached packing $cache (run bench_dense once with --cache)" >&2; exit 2; }
+log=$(mktemp)
+trap 'rm -f "$log"' EXIT
+for ((r = 1; r <= rounds; ++r)); do
+  # alternate which build goes first, so neither always runs right after the other
+  if ((r % 2)); then order=("A:$a" "B:$b"); else order=("B:$b" "A:$a"); fi
+  for entry in "${order[@]}"; do
+    tag=${entry%%:*}
+    dir=${entry#*:}
+    "$dir/bench/bench_dense" --threads "$threads" --steps "$steps" --repeats 1 --cache "$cache" 2>/dev/null |
+      awk -v tag="$tag" '/^result:/ { split($2, t, "="); split($3, q, "="); print tag, t[2], q[2] }' >>"$log"
+  done
+  echo "round $r/$rounds done" >&2
+done
+echo "A = $a"
+echo "B = $b"
+echo "rounds $rounds, $steps steps each; particle-steps/s"
+printf '%-3s %-8s %12s %12s\n' run threads median best
+sort -k1,1 -k2,2n -k3,3g "$log" | awk '
+  { key = $1 " " $2; v[key, ++n[key]] = $3; if (!(key in seen)) { seen[key] = 1; keys[++nk] = key } }
+  END {
+    for (k = 1; k <= nk; ++k) {
+      key = keys[k]; c = n[key]
+      med = (c % 2) ? v[key, (c + 1) / 2] : 0.5 * (v[key, c / 2] + v[key, c / 2 + 1])
+      split(key, f, " ")
+      printf "%-3s %-8s %12.4e %12.4e\n", f[1], f[2], med, v[key, c]
+    }
+  }'
