@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Interleaved A/B of two bench_dense builds on the cached 4000-sphere packing (docs/performance.md, "Method").
+# Interleaved A/B of two bench_dense builds on the cached 4000-sphere packing (docs/performance.md, "Commands").
 # On a shared VM one binary's rate moves by up to 2x between runs minutes apart, so the two builds are run in
 # alternation, ROUNDS times each, and the script prints the median and the best rate of each per thread count.
 # Noise from other tenants only ever slows a run, so the best of many short runs is the steadiest estimate.
@@ -19,15 +19,20 @@ for d in "$a" "$b"; do
 done
 [[ -f $cache ]] || { echo "bench/ab.sh: no cached packing $cache (run bench_dense once with --cache)" >&2; exit 2; }
 log=$(mktemp)
-trap 'rm -f "$log"' EXIT
+err=$(mktemp)
+trap 'rm -f "$log" "$err"' EXIT
 for ((r = 1; r <= rounds; ++r)); do
   # alternate which build goes first, so neither always runs right after the other
   if ((r % 2)); then order=("A:$a" "B:$b"); else order=("B:$b" "A:$a"); fi
   for entry in "${order[@]}"; do
     tag=${entry%%:*}
     dir=${entry#*:}
-    "$dir/bench/bench_dense" --threads "$threads" --steps "$steps" --repeats 1 --cache "$cache" 2>/dev/null |
-      awk -v tag="$tag" '/^result:/ { split($2, t, "="); split($3, q, "="); print tag, t[2], q[2] }' >>"$log"
+    out=$("$dir/bench/bench_dense" --threads "$threads" --steps "$steps" --repeats 1 --cache "$cache" 2>"$err") || {
+      echo "bench/ab.sh: $dir/bench/bench_dense failed in round $r:" >&2
+      cat "$err" >&2
+      exit 1
+    }
+    awk -v tag="$tag" '/^result:/ { split($2, t, "="); split($3, q, "="); print tag, t[2], q[2] }' <<<"$out" >>"$log"
   done
   echo "round $r/$rounds done" >&2
 done
