@@ -3,6 +3,8 @@
 # On a shared VM one binary's rate moves by up to 2x between runs minutes apart, so the two builds are run in
 # alternation, ROUNDS times each, and the script prints the median and the best rate of each per thread count.
 # Noise from other tenants only ever slows a run, so the best of many short runs is the steadiest estimate.
+# It also says whether the two builds computed the same bits (bench_dense's state fingerprint; older builds
+# without one print "none").
 #
 #   bench/ab.sh BUILD_A BUILD_B [ROUNDS=8] [STEPS=5000] [THREADS=1,2]
 #   e.g. bench/ab.sh /tmp/base/build build 10
@@ -32,6 +34,8 @@ for ((r = 1; r <= rounds; ++r)); do
       cat "$err" >&2
       exit 1
     }
+    fp=$(awk '/^state fingerprint/ { print $NF }' <<<"$out")
+    if [[ $tag == A ]]; then fpA=$fp; else fpB=$fp; fi
     awk -v tag="$tag" '/^result:/ { split($2, t, "="); split($3, q, "="); print tag, t[2], q[2] }' <<<"$out" >>"$log"
   done
   echo "round $r/$rounds done" >&2
@@ -39,6 +43,11 @@ done
 echo "A = $a"
 echo "B = $b"
 echo "rounds $rounds, $steps steps each; particle-steps/s"
+if [[ -n ${fpA:-} && $fpA == "${fpB:-}" ]]; then
+  echo "same bits: yes (state fingerprint $fpA in both)"
+else
+  echo "same bits: NO (state fingerprint A ${fpA:-none}, B ${fpB:-none})"
+fi
 printf '%-3s %-8s %12s %12s\n' run threads median best
 sort -k1,1 -k2,2n -k3,3g "$log" | awk '
   { key = $1 " " $2; v[key, ++n[key]] = $3; if (!(key in seen)) { seen[key] = 1; keys[++nk] = key } }

@@ -20,6 +20,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -231,6 +232,24 @@ double residentBytes() {
   return resident * static_cast<double>(sysconf(_SC_PAGESIZE));
 }
 
+// FNV-1a over the bits of the final positions, velocities, spins, contact forces and stress: two builds that
+// agree on it computed the same run bit for bit.
+std::uint64_t stateFingerprint(const Simulation& sim) {
+  std::uint64_t h = 1469598103934665603ull;
+  auto mix = [&h](const void* data, std::size_t bytes) {
+    const auto* c = static_cast<const unsigned char*>(data);
+    for (std::size_t k = 0; k < bytes; ++k) h = (h ^ c[k]) * 1099511628211ull;
+  };
+  const ParticleStore& p = sim.particles();
+  mix(p.pos.data(), p.pos.size() * sizeof(Vec3));
+  mix(p.vel.data(), p.vel.size() * sizeof(Vec3));
+  mix(p.angVel.data(), p.angVel.size() * sizeof(Vec3));
+  mix(p.force.data(), p.force.size() * sizeof(Vec3));
+  const Mat3 s = sim.contactStress();
+  mix(s.data(), sizeof(Mat3));
+  return h;
+}
+
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
@@ -273,13 +292,14 @@ int main(int argc, char** argv) {
     double median, lo, hi;  // particle-steps/s
     StageProfile profile;
     std::vector<Vec3> finalPos;
+    std::uint64_t fingerprint = 0;  // of the final state, to compare builds (bench/ab.sh)
     double pEnd, zEnd;
   };
   std::vector<Result> results;
   double memoryPerParticle = 0.0, peakResident = 0.0;
   for (int t : o.threads) {
     std::vector<double> rates;
-    Result res{t, 0, 0, 0, {}, {}, 0, 0};
+    Result res{t, 0, 0, 0, {}, {}, 0, 0, 0};
     std::vector<StageProfile> profiles;
     for (int r = 0; r < o.repeats; ++r) {
       Simulation sim = measuredScene(prepared, t, o);
@@ -294,6 +314,7 @@ int main(int argc, char** argv) {
       profiles.push_back(sim.profile());
       if (r == 0) {
         res.finalPos = sim.particles().pos;
+        res.fingerprint = stateFingerprint(sim);
         res.pEnd = sim.contactStress().trace() / 3.0;
         res.zEnd = contactCounts(sim).coordination;
       }
@@ -335,6 +356,9 @@ int main(int argc, char** argv) {
     std::printf("final positions bit-identical across thread counts: %s\n", same ? "yes" : "NO");
     if (!same) return 1;
   }
+  // same bits as another build? (bench/ab.sh compares this line between its two builds)
+  std::printf("state fingerprint after %ld steps: %016llx\n", o.steps,
+              static_cast<unsigned long long>(results[0].fingerprint));
   // machine-readable summary
   for (const Result& r : results)
     std::printf("result: threads=%d rate=%.6e ns_per_particle_step=%.3f N=%zu bytes_per_particle=%.0f\n", r.threads,
