@@ -14,6 +14,8 @@ namespace fl {
 namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+// -1, 0 or +1: the direction Cundall's local damping opposes (drift and kick)
+inline double signOf(double x) { return x > 0 ? 1.0 : (x < 0 ? -1.0 : 0.0); }
 }  // namespace
 
 const char* stageName(Stage s) {
@@ -150,8 +152,8 @@ void Simulation::drift() {
     Vec3 f = F[i], t = T[i];
     if (alpha > 0.0) {
       for (int k = 0; k < 3; ++k) {
-        f[k] -= alpha * std::abs(f[k]) * (v[i][k] > 0 ? 1.0 : (v[i][k] < 0 ? -1.0 : 0.0));
-        t[k] -= alpha * std::abs(t[k]) * (w[i][k] > 0 ? 1.0 : (w[i][k] < 0 ? -1.0 : 0.0));
+        f[k] -= alpha * std::abs(f[k]) * signOf(v[i][k]);
+        t[k] -= alpha * std::abs(t[k]) * signOf(w[i][k]);
       }
     }
     v[i] += (h * im[i]) * f;
@@ -238,6 +240,7 @@ void Simulation::kickPass() {
   const std::int32_t* adjStart = m_c.adjStart.data();
   const std::int32_t* adjEntry = m_c.adjEntry.data();
   const PairResult* res = m_c.result.data();
+  const int entries = adjStart[n];
   const double* rad = m_p.radius.data();
   Vec3* F = m_p.force.data();
   Vec3* T = m_p.torque.data();
@@ -256,10 +259,9 @@ void Simulation::kickPass() {
       // store-forwarding stall on the loop-carried torque (kick 5x slower).
       const double ri = rad[i];
       double fx = 0.0, fy = 0.0, fz = 0.0, tx = 0.0, ty = 0.0, tz = 0.0;
-      if (i + kPrefetchAhead < n)
-        for (int e = adjStart[i + kPrefetchAhead]; e < adjStart[i + kPrefetchAhead + 1]; ++e)
-          __builtin_prefetch(res + (adjEntry[e] >> 1));
       for (int e = adjStart[i]; e < adjStart[i + 1]; ++e) {
+        // the result line kPrefetchEntries entries ahead (about kPrefetchAhead particles)
+        if (e + kPrefetchEntries < entries) __builtin_prefetch(res + (adjEntry[e + kPrefetchEntries] >> 1));
         const int entry = adjEntry[e];
         const PairResult& c = res[entry >> 1];
         const double cfx = c.force.x(), cfy = c.force.y(), cfz = c.force.z();
@@ -281,10 +283,8 @@ void Simulation::kickPass() {
       if constexpr (kLocalDamping) {
         // Cundall non-viscous damping: each component of the force opposes the velocity by alpha |F|
         for (int a = 0; a < 3; ++a) {
-          const double sv = v[i][a] > 0 ? 1.0 : (v[i][a] < 0 ? -1.0 : 0.0);
-          const double sw = w[i][a] > 0 ? 1.0 : (w[i][a] < 0 ? -1.0 : 0.0);
-          f[a] -= alpha * std::abs(f[a]) * sv;
-          t[a] -= alpha * std::abs(t[a]) * sw;
+          f[a] -= alpha * std::abs(f[a]) * signOf(v[i][a]);
+          t[a] -= alpha * std::abs(t[a]) * signOf(w[i][a]);
           work += alpha * (std::abs(F[i][a] * v[i][a]) + std::abs(T[i][a] * w[i][a])) * m_dt;
         }
       }

@@ -178,6 +178,8 @@ class Simulation {
   // How far ahead (particles) the drift and the kick prefetch the lines they will write or gather: lines last
   // written by the other core arrive ~200 ns late on this kind of VM (docs/performance.md).
   static constexpr int kPrefetchAhead = 4;
+  // The kick's distance in adjacency entries: kPrefetchAhead particles of ~8.7 listed pairs each.
+  static constexpr int kPrefetchEntries = 35;
   // Partial sums of one fixed block of pairs (or particles), reduced in block order.
   struct Chunk {
     Mat3 stress = Mat3::Zero();  // sum f (x) l [N m]
