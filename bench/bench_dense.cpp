@@ -232,22 +232,19 @@ double residentBytes() {
   return resident * static_cast<double>(sysconf(_SC_PAGESIZE));
 }
 
-// FNV-1a over the bits of the final positions, velocities, spins, contact forces and stress: two builds that
-// agree on it computed the same run bit for bit.
+// The checkpoint checksum (fnv1a64) over the final particle state, contact history, forces and stress: two
+// builds that agree on it computed the same run bit for bit.
 std::uint64_t stateFingerprint(const Simulation& sim) {
-  std::uint64_t h = 1469598103934665603ull;
-  auto mix = [&h](const void* data, std::size_t bytes) {
-    const auto* c = static_cast<const unsigned char*>(data);
-    for (std::size_t k = 0; k < bytes; ++k) h = (h ^ c[k]) * 1099511628211ull;
-  };
   const ParticleStore& p = sim.particles();
-  mix(p.pos.data(), p.pos.size() * sizeof(Vec3));
-  mix(p.vel.data(), p.vel.size() * sizeof(Vec3));
-  mix(p.angVel.data(), p.angVel.size() * sizeof(Vec3));
-  mix(p.force.data(), p.force.size() * sizeof(Vec3));
-  const Mat3 s = sim.contactStress();
-  mix(s.data(), sizeof(Mat3));
-  return h;
+  BinaryWriter w;
+  w.putVector(p.pos);
+  w.putVector(p.vel);
+  w.putVector(p.angVel);
+  w.putVector(p.force);
+  w.putVector(p.torque);
+  w.putVector(sim.contacts().history);
+  w.put(sim.contactStress());
+  return fnv1a64(w.bytes());
 }
 
 double median(std::vector<double> v) {

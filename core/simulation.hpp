@@ -175,10 +175,11 @@ class Simulation {
   // Fixed reduction block (pairs or particles): results are independent of the thread count. Small enough
   // that 2 threads share ~60 blocks of a 4000-sphere packing evenly, large enough to amortise a block's sums.
   static constexpr std::size_t kChunk = 256;
-  // How far ahead (particles) the drift and the kick prefetch the lines they will write or gather: lines last
-  // written by the other core arrive ~200 ns late on this kind of VM (docs/performance.md).
+  // How far ahead (particles) the drift prefetches the lines it will write: lines last written by the other
+  // core arrive ~200 ns late on this kind of VM (docs/performance.md).
   static constexpr int kPrefetchAhead = 4;
-  // The kick's distance in adjacency entries: kPrefetchAhead particles of ~8.7 listed pairs each.
+  // How far ahead (adjacency entries) the kick prefetches the result lines it will gather: about kPrefetchAhead
+  // particles of the dense packing's ~8.7 listed pairs each.
   static constexpr int kPrefetchEntries = 35;
   // Partial sums of one fixed block of pairs (or particles), reduced in block order.
   struct Chunk {
