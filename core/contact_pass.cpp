@@ -13,7 +13,15 @@
 namespace fl {
 
 namespace {
-// The arrays both contact passes read and write, as plain pointers for the OpenMP loops.
+// l = x_j + H image - x_i: the branch vector from i to the periodic image of j that a pair couples
+inline Vec3 branchVector(const Vec3& xi, const Vec3& xj, Image img, const Mat3& H) {
+  Vec3 d = xj - xi;
+  if (!img.isZero()) d += H * img.vec().cast<double>();
+  return d;
+}
+
+// What both contact passes read and write: the arrays as plain pointers for the OpenMP loops, the cell's
+// H and L, the time step and the pair count.
 struct PassArrays {
   const Vec3* x;    // positions
   const Vec3* v;    // fluctuating velocities
@@ -26,17 +34,17 @@ struct PassArrays {
   const Image* image;
   ContactHistory* hist;
   PairResult* result;
-  PassArrays(const ParticleStore& p, ContactStore& c)
+  const Mat3& H;  // cell matrix
+  const Mat3& L;  // velocity gradient
+  double dt;      // [s]
+  std::size_t np;  // listed pairs
+  PassArrays(const ParticleStore& p, ContactStore& c, const PeriodicCell& cell, double timeStep)
       : x(p.pos.data()), v(p.vel.data()), w(p.angVel.data()), rad(p.radius.data()), im(p.invMass.data()),
         mat(p.material.data()), first(c.first.data()), second(c.second.data()), image(c.image.data()),
-        hist(c.history.data()), result(c.result.data()) {}
-  // l = x_j + H image - x_i: the branch vector from i to the periodic image of j that pair p couples
-  Vec3 branch(std::size_t p, int i, int j, const Mat3& H) const {
-    Vec3 d = x[j] - x[i];
-    const Image img = image[p];
-    if (!img.isZero()) d += H * img.vec().cast<double>();
-    return d;
-  }
+        hist(c.history.data()), result(c.result.data()), H(cell.matrix()), L(cell.velocityGradient()),
+        dt(timeStep), np(c.size()) {}
+  std::size_t chunks(std::size_t chunk) const { return (np + chunk - 1) / chunk; }
+  Vec3 branch(std::size_t p, int i, int j) const { return branchVector(x[i], x[j], image[p], H); }
 };
 }  // namespace
 
@@ -86,16 +94,14 @@ void Simulation::contactPass() {
 template <bool kEnergy, bool kDamping, bool kAffine>
 void Simulation::contactPassBlocked() {
   // Three phases per block of listed pairs, all within one reduction chunk (so the bits do not depend on
-  // the thread count): 1. gather the touching pairs' inputs into a PairBlock (branch-free compaction);
+  // the thread count): 1. gather the touching pairs' inputs into a PairBlock (branch-free compaction), the
+  // particles' x, r, v and 1/m from their one-line copy (m_pass), omega and material from the store;
   // 2. the law, vectorised across the block (kernels::hertzMindlinBlock); 3. scatter the results and
   // history back and sum the chunk's partials in pair order.
   static_assert(kChunk % kernels::kBlockPairs == 0, "reduction chunks hold whole blocks");
-  const std::size_t np = m_c.size();
-  const std::size_t nchunks = (np + kChunk - 1) / kChunk;
-  const Mat3& H = m_cell.matrix();
-  const Mat3& L = m_cell.velocityGradient();
-  const double dt = m_dt;
-  const PassArrays arr(m_p, m_c);
+  const PassArrays arr(m_p, m_c, m_cell, m_dt);
+  const std::size_t np = arr.np, nchunks = arr.chunks(kChunk);
+  const PassParticle* pass = m_pass.data();  // x, r, v, 1/m in one line per particle
   const PairTable& table = m_pairs;
   Chunk* chunks = m_chunks.data();
 #pragma omp parallel num_threads(m_num.threads)
@@ -119,12 +125,11 @@ void Simulation::contactPassBlocked() {
           // core (the partners across the threads' boundary) arrives ~200 ns late (docs/performance.md)
           if (p + kernels::kBlockPairs < np) {
             const int jn = arr.second[p + kernels::kBlockPairs];
-            __builtin_prefetch(arr.x + jn);
-            __builtin_prefetch(arr.v + jn);
+            __builtin_prefetch(pass + jn);
             __builtin_prefetch(arr.w + jn);
           }
-          const Vec3 d = arr.branch(p, i, j, H);
-          const double ri = arr.rad[i], rj = arr.rad[j];
+          const Vec3 d = branchVector(pass[i].x, pass[j].x, arr.image[p], arr.H);
+          const double ri = pass[i].radius, rj = pass[j].radius;
           const double R = ri + rj;
           const double dist2 = d.squaredNorm();
           const int touching = dist2 < R * R;
@@ -144,14 +149,14 @@ void Simulation::contactPassBlocked() {
           const int i = arr.first[p], j = arr.second[p];
           // relative velocity of the centres, with the mean field L·d, which carries the image shift
           // velocity L·H·n for pairs across the boundary (verification ladder §2)
-          Vec3 vr = arr.v[j] - arr.v[i];
-          if constexpr (kAffine) vr += L * Vec3(b.dx[s], b.dy[s], b.dz[s]);
+          Vec3 vr = pass[j].v - pass[i].v;
+          if constexpr (kAffine) vr += arr.L * Vec3(b.dx[s], b.dy[s], b.dz[s]);
           const PairParams& pp = table(arr.mat[i], arr.mat[j]);
           const ContactHistory& h = arr.hist[p];
           b.vx[s] = vr.x(), b.vy[s] = vr.y(), b.vz[s] = vr.z();
           b.wix[s] = arr.w[i].x(), b.wiy[s] = arr.w[i].y(), b.wiz[s] = arr.w[i].z();
           b.wjx[s] = arr.w[j].x(), b.wjy[s] = arr.w[j].y(), b.wjz[s] = arr.w[j].z();
-          b.invMassSum[s] = arr.im[i] + arr.im[j];
+          b.invMassSum[s] = pass[i].invMass + pass[j].invMass;
           b.effYoung[s] = pp.effYoung, b.effShear[s] = pp.effShear;
           b.friction[s] = pp.friction, b.dampingRatio[s] = pp.dampingRatio;
           b.tx[s] = h.tangentialForce.x(), b.ty[s] = h.tangentialForce.y(), b.tz[s] = h.tangentialForce.z();
@@ -164,7 +169,7 @@ void Simulation::contactPassBlocked() {
         }
         b.count = m;
         // 2. the law across the block
-        kernels::hertzMindlinBlock<kDamping, kEnergy>(b, dt);
+        kernels::hertzMindlinBlock<kDamping, kEnergy>(b, arr.dt);
         // 3. scatter, and the chunk's sums in pair order
         for (int s = 0; s < m; ++s) {
           const std::size_t p = static_cast<std::size_t>(index[s]);
@@ -184,7 +189,7 @@ void Simulation::contactPassBlocked() {
             acc.elasticN += b.elasticN[s];
             acc.elasticT += b.storedT[s];
             acc.friction += b.dissipatedT[s];
-            acc.damping += b.dampPower[s] * dt;
+            acc.damping += b.dampPower[s] * arr.dt;
           }
         }
         acc.contacts += static_cast<std::size_t>(m);
@@ -197,12 +202,10 @@ void Simulation::contactPassBlocked() {
 
 template <bool kEnergy, bool kDamping, bool kAffine>
 void Simulation::contactPassMindlinDeresiewicz() {
-  const std::size_t np = m_c.size();
-  const std::size_t nchunks = (np + kChunk - 1) / kChunk;
-  const Mat3& H = m_cell.matrix();
-  const Mat3& L = m_cell.velocityGradient();
-  const double dt = m_dt;
-  const PassArrays arr(m_p, m_c);
+  const PassArrays arr(m_p, m_c, m_cell, m_dt);
+  const std::size_t np = arr.np, nchunks = arr.chunks(kChunk);
+  const Mat3& L = arr.L;
+  const double dt = arr.dt;
   MdHistory* mdHist = m_c.mdHistory.data();
   const PairTable& table = m_pairs;
   Chunk* chunks = m_chunks.data();
@@ -212,7 +215,7 @@ void Simulation::contactPassMindlinDeresiewicz() {
     const std::size_t end = std::min(np, (k + 1) * kChunk);
     for (std::size_t p = k * kChunk; p < end; ++p) {
       const int i = arr.first[p], j = arr.second[p];
-      const Vec3 d = arr.branch(p, i, j, H);
+      const Vec3 d = arr.branch(p, i, j);
       const double ri = arr.rad[i], rj = arr.rad[j];
       const double R = ri + rj;
       const double dist2 = d.squaredNorm();

@@ -1,6 +1,7 @@
 #include "invariants.hpp"
 
 #include <cmath>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,17 @@ void checkInvariants(const Simulation& sim) {
     if (!p.pos[i].allFinite() || !p.vel[i].allFinite() || !p.angVel[i].allFinite() || !p.force[i].allFinite())
       violated("particle " + std::to_string(i) + " has a non-finite position, velocity or force");
   if (!(sim.cell().volume() > 0.0)) violated("cell volume <= 0");
+  // the contact pass reads its own copy of the particles: it must hold the store's bits (but for the
+  // velocity, which the kick has moved on by half a step since the pass read it)
+  const std::vector<PassParticle>& pass = sim.passParticles();
+  if (pass.size() != n) violated("the contact pass's particle copy has the wrong length");
+  for (std::size_t i = 0; i < n; ++i) {
+    const PassParticle& q = pass[i];
+    if (std::memcmp(q.x.data(), p.pos[i].data(), sizeof(Vec3)) != 0 ||
+        std::memcmp(&q.radius, &p.radius[i], sizeof(double)) != 0 ||
+        std::memcmp(&q.invMass, &p.invMass[i], sizeof(double)) != 0)
+      violated("the contact pass's copy of particle " + std::to_string(i) + " differs from the store");
+  }
   std::vector<int> seen(n, 0);
   for (std::size_t k = 0; k < c.size(); ++k) {
     const int i = c.first[k], j = c.second[k];

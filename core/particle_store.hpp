@@ -12,6 +12,18 @@
 
 namespace fl {
 
+// What the contact pass reads of one particle, in one 64-byte line (issue 6): the pass visits each partner
+// through its index, and six separate arrays cost it up to six lines per partner. A copy of the store's
+// values, written by the drift for every particle and refilled whole when positions are wrapped or masses
+// change (Simulation::packPassParticles); the store stays the one owner of the state.
+struct alignas(64) PassParticle {
+  Vec3 x;          // position [m]
+  double radius;   // r [m]
+  Vec3 v;          // fluctuating velocity at the pass, i.e. after the drift's half kick [m/s]
+  double invMass;  // 1/m [1/kg]
+};
+static_assert(sizeof(PassParticle) == 64, "one cache line per particle");
+
 struct ParticleStore {
   // hot
   std::vector<Vec3> pos;      // x [m]

@@ -141,6 +141,7 @@ void Simulation::drift() {
   const double* im = m_p.invMass.data();
   const double* ii = m_p.invInertia.data();
   const Vec3* x0 = m_refPos.data();
+  PassParticle* pass = m_pass.data();
   double maxd2 = 0.0;
 #pragma omp parallel for num_threads(m_num.threads) schedule(static) reduction(max : maxd2)
   for (int i = 0; i < n; ++i) {
@@ -148,6 +149,7 @@ void Simulation::drift() {
       __builtin_prefetch(x + i + kPrefetchAhead, 1);
       __builtin_prefetch(v + i + kPrefetchAhead, 1);
       __builtin_prefetch(w + i + kPrefetchAhead, 1);
+      __builtin_prefetch(pass + i + kPrefetchAhead, 1);
     }
     Vec3 f = F[i], t = T[i];
     if (alpha > 0.0) {
@@ -159,6 +161,8 @@ void Simulation::drift() {
     v[i] += (h * im[i]) * f;
     w[i] += (h * ii[i]) * t;
     x[i] = affine ? Vec3(phi * x[i] + dt * v[i]) : Vec3(x[i] + dt * v[i]);
+    pass[i].x = x[i];
+    pass[i].v = v[i];
     const Vec3 u = x[i] - Fref * x0[i];
     maxd2 = std::max(maxd2, u.squaredNorm());
   }
@@ -218,6 +222,13 @@ void Simulation::rebuildNeighbours() {
   m_refHinv = m_cell.inverse();
   m_maxDisp2 = 0.0;
   resizeChunks();
+  packPassParticles();
+}
+
+void Simulation::packPassParticles() {
+  const std::size_t n = m_p.size();
+  m_pass.resize(n);
+  for (std::size_t i = 0; i < n; ++i) m_pass[i] = {m_p.pos[i], m_p.radius[i], m_p.vel[i], m_p.invMass[i]};
 }
 
 void Simulation::resizeChunks() {
@@ -306,7 +317,7 @@ std::size_t Simulation::memoryBytes() const {
   return b(p.pos) + b(p.vel) + b(p.angVel) + b(p.force) + b(p.torque) + b(p.radius) + b(p.invMass) +
          b(p.invInertia) + b(p.id) + b(p.material) + b(p.image) + b(c.first) + b(c.second) + b(c.image) +
          b(c.history) + b(c.mdHistory) + b(c.result) + b(c.adjStart) + b(c.adjEntry) + b(m_refPos) +
-         b(m_chunks);
+         b(m_pass) + b(m_chunks);
 }
 
 // ---- measures -----------------------------------------------------------------------------------

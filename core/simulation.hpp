@@ -73,6 +73,9 @@ class Simulation {
   ParticleStore& mutableParticles() { return m_p; }  // callers must call refresh() after editing
   const PeriodicCell& cell() const { return m_cell; }
   const ContactStore& contacts() const { return m_c; }
+  // The contact pass's copy of x, r, v, 1/m, one line per particle. Between steps x, r and 1/m equal the
+  // store's (checkInvariants checks it); v is the mid-step velocity the last pass used.
+  const std::vector<PassParticle>& passParticles() const { return m_pass; }
   const std::vector<Material>& materials() const { return m_materials; }
   const NumericsSettings& numerics() const { return m_num; }
   double time() const { return m_time; }     // [s]
@@ -129,6 +132,7 @@ class Simulation {
   bool needsRebuild() const;
   void rebuildNeighbours();
   void resizeChunks();  // m_chunks for the current pair and particle counts
+  void packPassParticles();  // m_pass from the particle store, whole
   void computeContacts();
   Simulation() = default;  // for restoreState
   template <bool kMindlinDeresiewicz>
@@ -152,6 +156,7 @@ class Simulation {
   void kickPass();
 
   ParticleStore m_p;
+  std::vector<PassParticle> m_pass;  // the contact pass's copy of x, r, v, 1/m (particle_store.hpp)
   PeriodicCell m_cell;
   std::vector<Material> m_materials;
   PairTable m_pairs;

@@ -226,6 +226,7 @@ Simulation Simulation::restoreState(BinaryReader& r) {
   // friction may have been changed during the run: the materials carry the current value
   s.m_pairs = PairTable(s.m_materials, s.m_num.restitution);
   s.resizeChunks();
+  s.packPassParticles();
   return s;
 }
 
@@ -247,6 +248,7 @@ void Simulation::reconfigure(const Material& material, const NumericsSettings& n
   m_pairs = PairTable(m_materials, m_num.restitution);
   m_rayleigh = rayleighTimeStep(m_p, m_materials, m_num.densityScale);
   m_dt = m_num.timeStep > 0.0 ? m_num.timeStep : m_num.timeStepFactor * m_rayleigh;
+  packPassParticles();  // new masses
   syncTangentialHistory();  // the scene may select another tangential law
 }
 

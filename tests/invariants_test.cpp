@@ -3,6 +3,7 @@
 
 #include "core/errors.hpp"
 #include "core/gas_generator.hpp"
+#include "core/binary_io.hpp"
 #include "core/invariants.hpp"
 
 using namespace fl;
@@ -26,4 +27,38 @@ TEST(Invariants, HoldOnACompressedFrictionalPackingAndCatchCorruption) {
   Simulation broken = std::move(sim);
   broken.mutableParticles().vel[7].x() = std::nan("");
   EXPECT_THROW(checkInvariants(broken), Error);
+}
+
+// The contact pass reads a copy of x, r, v and 1/m (PassParticle). It must follow the store through every
+// path that changes them: drift, rebuild (wrapping), restore, reconfigure (new masses) and refresh after an
+// edit; an edit without refresh() leaves it stale, and the check says so.
+TEST(Invariants, ContactPassCopyFollowsRestoreReconfigureAndEdits) {
+  GasSpec g;
+  g.count = 300;
+  g.solidFraction = 0.4;
+  Packing pk = generateGas(g);
+  NumericsSettings num;
+  num.restitution = 0.5;
+  Simulation sim(std::move(pk.particles), pk.cell, {Material::paperGlass()}, num);
+  Mat3 L = Mat3::Zero();
+  L.diagonal().setConstant(-300);
+  sim.setVelocityGradient(L);
+  sim.run(2000);
+  ASSERT_GT(sim.profile().rebuilds, 0);
+  EXPECT_NO_THROW(checkInvariants(sim));
+  BinaryWriter w;
+  sim.saveState(w);
+  BinaryReader r(w.bytes(), "state");
+  Simulation b = Simulation::restoreState(r);
+  EXPECT_NO_THROW(checkInvariants(b));
+  Material heavier = Material::paperGlass();
+  heavier.density *= 3.0;
+  b.reconfigure(heavier, num);
+  EXPECT_NO_THROW(checkInvariants(b));
+  b.run(50);
+  EXPECT_NO_THROW(checkInvariants(b));
+  b.mutableParticles().radius[3] *= 1.01;
+  EXPECT_THROW(checkInvariants(b), Error);
+  b.refresh();
+  EXPECT_NO_THROW(checkInvariants(b));
 }
