@@ -271,7 +271,7 @@ void Simulation::kickPass() {
       const double ri = rad[i];
       double fx = 0.0, fy = 0.0, fz = 0.0, tx = 0.0, ty = 0.0, tz = 0.0;
       for (int e = adjStart[i]; e < adjStart[i + 1]; ++e) {
-        // the result line kPrefetchEntries entries ahead (about kPrefetchAhead particles)
+        // the result line kPrefetchEntries entries ahead (about 16 particles)
         if (e + kPrefetchEntries < entries) __builtin_prefetch(res + (adjEntry[e + kPrefetchEntries] >> 1));
         const int entry = adjEntry[e];
         const PairResult& c = res[entry >> 1];

@@ -180,12 +180,14 @@ class Simulation {
   // Fixed reduction block (pairs or particles): results are independent of the thread count. Small enough
   // that 2 threads share ~60 blocks of a 4000-sphere packing evenly, large enough to amortise a block's sums.
   static constexpr std::size_t kChunk = 256;
-  // How far ahead (particles) the drift prefetches the lines it will write: lines last written by the other
-  // core arrive ~200 ns late on this kind of VM (docs/performance.md).
-  static constexpr int kPrefetchAhead = 4;
-  // How far ahead (adjacency entries) the kick prefetches the result lines it will gather: about kPrefetchAhead
-  // particles of the dense packing's ~8.7 listed pairs each.
-  static constexpr int kPrefetchEntries = 35;
+  // How far ahead (particles) the drift prefetches the lines it will write: lines last read by the other
+  // core arrive ~200 ns late on this kind of VM, ~25 particles' work at ~8 ns each (docs/performance.md,
+  // "per-thread busy time": 4 ahead left the second thread's drift 50 % slower than the first's).
+  static constexpr int kPrefetchAhead = 32;
+  // How far ahead (adjacency entries) the kick prefetches the result lines it will gather: ~16 particles of
+  // the dense packing's ~8.7 listed pairs each, ~200 ns of the kick's work (35 entries left the second
+  // thread, which gathers the results the first wrote across the boundary, 20 % slower).
+  static constexpr int kPrefetchEntries = 140;
   // Partial sums of one fixed block of pairs (or particles), reduced in block order.
   struct Chunk {
     Mat3 stress = Mat3::Zero();  // sum f (x) l [N m]
