@@ -8,10 +8,12 @@
 
 using namespace fl;
 
-TEST(Invariants, HoldOnACompressedFrictionalPackingAndCatchCorruption) {
+namespace {
+// A frictional gas of glass beads under isotropic compression (strain rate 300/s), restitution 0.5.
+Simulation compressingGas(int count, double solidFraction) {
   GasSpec g;
-  g.count = 500;
-  g.solidFraction = 0.35;
+  g.count = count;
+  g.solidFraction = solidFraction;
   Packing pk = generateGas(g);
   NumericsSettings num;
   num.restitution = 0.5;
@@ -19,6 +21,12 @@ TEST(Invariants, HoldOnACompressedFrictionalPackingAndCatchCorruption) {
   Mat3 L = Mat3::Zero();
   L.diagonal().setConstant(-300);
   sim.setVelocityGradient(L);
+  return sim;
+}
+}  // namespace
+
+TEST(Invariants, HoldOnACompressedFrictionalPackingAndCatchCorruption) {
+  Simulation sim = compressingGas(500, 0.35);
   for (int k = 0; k < 60; ++k) {
     sim.run(100);
     EXPECT_NO_THROW(checkInvariants(sim));
@@ -33,16 +41,7 @@ TEST(Invariants, HoldOnACompressedFrictionalPackingAndCatchCorruption) {
 // path that changes them: drift, rebuild (wrapping), restore, reconfigure (new masses) and refresh after an
 // edit; an edit without refresh() leaves it stale, and the check says so.
 TEST(Invariants, ContactPassCopyFollowsRestoreReconfigureAndEdits) {
-  GasSpec g;
-  g.count = 300;
-  g.solidFraction = 0.4;
-  Packing pk = generateGas(g);
-  NumericsSettings num;
-  num.restitution = 0.5;
-  Simulation sim(std::move(pk.particles), pk.cell, {Material::paperGlass()}, num);
-  Mat3 L = Mat3::Zero();
-  L.diagonal().setConstant(-300);
-  sim.setVelocityGradient(L);
+  Simulation sim = compressingGas(300, 0.4);
   sim.run(2000);
   ASSERT_GT(sim.profile().rebuilds, 0);
   EXPECT_NO_THROW(checkInvariants(sim));
@@ -53,7 +52,7 @@ TEST(Invariants, ContactPassCopyFollowsRestoreReconfigureAndEdits) {
   EXPECT_NO_THROW(checkInvariants(b));
   Material heavier = Material::paperGlass();
   heavier.density *= 3.0;
-  b.reconfigure(heavier, num);
+  b.reconfigure(heavier, b.numerics());
   EXPECT_NO_THROW(checkInvariants(b));
   b.run(50);
   EXPECT_NO_THROW(checkInvariants(b));
