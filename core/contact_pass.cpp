@@ -109,6 +109,16 @@ void Simulation::contactPassBlocked() {
     kernels::PairBlock b{};  // per thread, ~23 KiB: stays in L1 through the three phases
     std::int32_t index[kernels::kBlockPairs];       // pair of each slot
     std::int32_t staleIndex[kernels::kBlockPairs];  // pairs whose contact opened this step
+    // one material (the paper's scenes): every pair has the same parameters, written into all the block's
+    // slots once per pass (the friction may have changed since the last), not gathered per pair
+    const bool oneMaterial = table.materialCount() == 1;
+    if (oneMaterial) {
+      const PairParams& pp = table(0, 0);
+      std::fill_n(b.effYoung, kernels::kBlockPairs, pp.effYoung);
+      std::fill_n(b.effShear, kernels::kBlockPairs, pp.effShear);
+      std::fill_n(b.friction, kernels::kBlockPairs, pp.friction);
+      std::fill_n(b.dampingRatio, kernels::kBlockPairs, pp.dampingRatio);
+    }
 #pragma omp for schedule(static)
     for (std::size_t k = 0; k < nchunks; ++k) {
       Chunk acc;
@@ -151,14 +161,16 @@ void Simulation::contactPassBlocked() {
           // velocity L·H·n for pairs across the boundary (verification ladder §2)
           Vec3 vr = pass[j].v - pass[i].v;
           if constexpr (kAffine) vr += arr.L * Vec3(b.dx[s], b.dy[s], b.dz[s]);
-          const PairParams& pp = table(arr.mat[i], arr.mat[j]);
           const ContactHistory& h = arr.hist[p];
           b.vx[s] = vr.x(), b.vy[s] = vr.y(), b.vz[s] = vr.z();
           b.wix[s] = arr.w[i].x(), b.wiy[s] = arr.w[i].y(), b.wiz[s] = arr.w[i].z();
           b.wjx[s] = arr.w[j].x(), b.wjy[s] = arr.w[j].y(), b.wjz[s] = arr.w[j].z();
           b.invMassSum[s] = pass[i].invMass + pass[j].invMass;
-          b.effYoung[s] = pp.effYoung, b.effShear[s] = pp.effShear;
-          b.friction[s] = pp.friction, b.dampingRatio[s] = pp.dampingRatio;
+          if (!oneMaterial) {
+            const PairParams& pp = table(arr.mat[i], arr.mat[j]);
+            b.effYoung[s] = pp.effYoung, b.effShear[s] = pp.effShear;
+            b.friction[s] = pp.friction, b.dampingRatio[s] = pp.dampingRatio;
+          }
           b.tx[s] = h.tangentialForce.x(), b.ty[s] = h.tangentialForce.y(), b.tz[s] = h.tangentialForce.z();
           b.aPrev[s] = h.contactRadius;
         }

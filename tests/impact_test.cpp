@@ -155,3 +155,46 @@ TEST(ObliqueImpact, RestitutionSettingGivesThatNormalRestitution) {
     }
   }
 }
+
+// The force pass reads each pair's parameters from the pair table when the scene has several materials,
+// and writes the one pair's parameters into its blocks once per pass when it has one (contact_pass.cpp):
+// both must give Hertz with that pair's E* and cap F_t at that pair's current friction.
+namespace {
+// Spheres of radius R overlapping by delta along x, the second sliding along y at 10 m/s (gross sliding in
+// the first pass: the spring's first increment is several times mu F_n).
+Simulation slidingPair(const std::vector<Material>& materials, int matA, int matB, double R, double delta) {
+  ParticleStore p;
+  const Vec3 x1(0.5, 0.5, 0.5);
+  p.add(x1, R, materials[matA].density, matA);
+  p.add(x1 + Vec3(2 * R - delta, 0, 0), R, materials[matB].density, matB);
+  p.vel[1] = Vec3(0, 10, 0);
+  NumericsSettings num;
+  num.timeStep = 1e-7;
+  return Simulation(std::move(p), PeriodicCell::box(1, 1, 1), materials, num);
+}
+void expectHertzAtCap(const Simulation& sim, double effYoung, double R, double mu) {
+  const PairResult& c = sim.contacts().result.at(0);
+  ASSERT_GT(c.overlap, 0.0);
+  const double a = std::sqrt(0.5 * R * c.overlap);
+  EXPECT_NEAR(c.normalForce / (4.0 / 3.0 * effYoung * a * c.overlap), 1.0, 1e-12);
+  const Vec3 ft = c.force - c.normalForce * c.normal;
+  EXPECT_NEAR(ft.norm() / (mu * c.normalForce), 1.0, 1e-12);
+}
+}  // namespace
+
+TEST(PairParameters, ForcePassUsesEachPairsMaterialsAndTheCurrentFriction) {
+  const double R = 1e-3, delta = 1e-6;
+  const Material a{"a", 70e9, 0.22, 2500, 0.3}, b{"b", 20e9, 0.25, 2500, 0.5};
+  // two materials: the table's (a, b) entry, friction min(0.3, 0.5)
+  Simulation ab = slidingPair({a, b}, 0, 1, R, delta);
+  EXPECT_NEAR(ab.contacts().result.at(0).overlap, delta, 1e-15);
+  expectHertzAtCap(ab, test::effYoung(a, b), R, 0.3);
+  Simulation bb = slidingPair({a, b}, 1, 1, R, delta);
+  expectHertzAtCap(bb, test::effYoung(b, b), R, 0.5);
+  // one material, its friction changed during the run: the next pass caps at the new value
+  Simulation one = slidingPair({b}, 0, 0, R, delta);
+  expectHertzAtCap(one, test::effYoung(b, b), R, 0.5);
+  one.setFriction(0.1);
+  one.step();
+  expectHertzAtCap(one, test::effYoung(b, b), R, 0.1);
+}
