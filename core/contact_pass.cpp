@@ -13,21 +13,12 @@
 namespace fl {
 
 namespace {
-// l = x_j + H image - x_i: the branch vector from i to the periodic image of j that a pair couples
-inline Vec3 branchVector(const Vec3& xi, const Vec3& xj, Image img, const Mat3& H) {
-  Vec3 d = xj - xi;
-  if (!img.isZero()) d += H * img.vec().cast<double>();
-  return d;
-}
-
 // What both contact passes read and write: the arrays as plain pointers for the OpenMP loops, the cell's
-// H and L, the time step and the pair count.
+// H and L, the time step and the pair count. The particles' x, r, v and 1/m come from their one-line copy
+// (PassParticle, particle_store.hpp), omega and the material from the store.
 struct PassArrays {
-  const Vec3* x;    // positions
-  const Vec3* v;    // fluctuating velocities
-  const Vec3* w;    // angular velocities
-  const double* rad;
-  const double* im;  // 1/m
+  const PassParticle* pp;  // x, r, v, 1/m
+  const Vec3* w;           // angular velocities
   const std::uint16_t* mat;
   const std::int32_t* first;
   const std::int32_t* second;
@@ -38,13 +29,19 @@ struct PassArrays {
   const Mat3& L;  // velocity gradient
   double dt;      // [s]
   std::size_t np;  // listed pairs
-  PassArrays(const ParticleStore& p, ContactStore& c, const PeriodicCell& cell, double timeStep)
-      : x(p.pos.data()), v(p.vel.data()), w(p.angVel.data()), rad(p.radius.data()), im(p.invMass.data()),
-        mat(p.material.data()), first(c.first.data()), second(c.second.data()), image(c.image.data()),
-        hist(c.history.data()), result(c.result.data()), H(cell.matrix()), L(cell.velocityGradient()),
-        dt(timeStep), np(c.size()) {}
+  PassArrays(const std::vector<PassParticle>& pass, const ParticleStore& p, ContactStore& c,
+             const PeriodicCell& cell, double timeStep)
+      : pp(pass.data()), w(p.angVel.data()), mat(p.material.data()), first(c.first.data()),
+        second(c.second.data()), image(c.image.data()), hist(c.history.data()), result(c.result.data()),
+        H(cell.matrix()), L(cell.velocityGradient()), dt(timeStep), np(c.size()) {}
   std::size_t chunks(std::size_t chunk) const { return (np + chunk - 1) / chunk; }
-  Vec3 branch(std::size_t p, int i, int j) const { return branchVector(x[i], x[j], image[p], H); }
+  // l = x_j + H image - x_i for pair p = (i, j, image)
+  Vec3 branch(std::size_t p, int i, int j) const {
+    Vec3 d = pp[j].x - pp[i].x;
+    const Image img = image[p];
+    if (!img.isZero()) d += H * img.vec().cast<double>();
+    return d;
+  }
 };
 }  // namespace
 
@@ -94,14 +91,13 @@ void Simulation::contactPass() {
 template <bool kEnergy, bool kDamping, bool kAffine>
 void Simulation::contactPassBlocked() {
   // Three phases per block of listed pairs, all within one reduction chunk (so the bits do not depend on
-  // the thread count): 1. gather the touching pairs' inputs into a PairBlock (branch-free compaction), the
-  // particles' x, r, v and 1/m from their one-line copy (m_pass), omega and material from the store;
+  // the thread count): 1. gather the touching pairs' inputs into a PairBlock (branch-free compaction);
   // 2. the law, vectorised across the block (kernels::hertzMindlinBlock); 3. scatter the results and
   // history back and sum the chunk's partials in pair order.
   static_assert(kChunk % kernels::kBlockPairs == 0, "reduction chunks hold whole blocks");
-  const PassArrays arr(m_p, m_c, m_cell, m_dt);
+  const PassArrays arr(m_pass, m_p, m_c, m_cell, m_dt);
   const std::size_t np = arr.np, nchunks = arr.chunks(kChunk);
-  const PassParticle* pass = m_pass.data();  // x, r, v, 1/m in one line per particle
+  const PassParticle* pass = arr.pp;
   const PairTable& table = m_pairs;
   Chunk* chunks = m_chunks.data();
 #pragma omp parallel num_threads(m_num.threads)
@@ -138,7 +134,7 @@ void Simulation::contactPassBlocked() {
             __builtin_prefetch(pass + jn);
             __builtin_prefetch(arr.w + jn);
           }
-          const Vec3 d = branchVector(pass[i].x, pass[j].x, arr.image[p], arr.H);
+          const Vec3 d = arr.branch(p, i, j);
           const double ri = pass[i].radius, rj = pass[j].radius;
           const double R = ri + rj;
           const double dist2 = d.squaredNorm();
@@ -214,8 +210,9 @@ void Simulation::contactPassBlocked() {
 
 template <bool kEnergy, bool kDamping, bool kAffine>
 void Simulation::contactPassMindlinDeresiewicz() {
-  const PassArrays arr(m_p, m_c, m_cell, m_dt);
+  const PassArrays arr(m_pass, m_p, m_c, m_cell, m_dt);
   const std::size_t np = arr.np, nchunks = arr.chunks(kChunk);
+  const PassParticle* pass = arr.pp;
   const Mat3& L = arr.L;
   const double dt = arr.dt;
   MdHistory* mdHist = m_c.mdHistory.data();
@@ -228,7 +225,7 @@ void Simulation::contactPassMindlinDeresiewicz() {
     for (std::size_t p = k * kChunk; p < end; ++p) {
       const int i = arr.first[p], j = arr.second[p];
       const Vec3 d = arr.branch(p, i, j);
-      const double ri = arr.rad[i], rj = arr.rad[j];
+      const double ri = pass[i].radius, rj = pass[j].radius;
       const double R = ri + rj;
       const double dist2 = d.squaredNorm();
       if (dist2 >= R * R) {
@@ -249,7 +246,7 @@ void Simulation::contactPassMindlinDeresiewicz() {
       const double li = ri - 0.5 * delta, lj = rj - 0.5 * delta;
       // relative velocity of j's contact point w.r.t. i's, including the mean field L·l, which carries the
       // image shift velocity L·H·n for pairs across the boundary (verification ladder §2)
-      Vec3 vrel = arr.v[j] - arr.v[i] - (lj * arr.w[j] + li * arr.w[i]).cross(n);
+      Vec3 vrel = pass[j].v - pass[i].v - (lj * arr.w[j] + li * arr.w[i]).cross(n);
       if constexpr (kAffine) vrel += L * d;
       const double vn = vrel.dot(n);
       const Vec3 vt = vrel - vn * n;
@@ -262,7 +259,7 @@ void Simulation::contactPassMindlinDeresiewicz() {
       double dampPower = 0.0;
       double mstar = 0.0;
       if constexpr (kDamping) {
-        mstar = 1.0 / (arr.im[i] + arr.im[j]);
+        mstar = 1.0 / (pass[i].invMass + pass[j].invMass);
         const double cn = kernels::dampingCoefficient(pp.dampingRatio, kn, mstar);
         fn = std::max(0.0, fe - cn * vn);  // no attraction
         dampPower += (fe - fn) * vn;       // = cn vn^2 unless clamped
@@ -295,7 +292,7 @@ void Simulation::contactPassMindlinDeresiewicz() {
       ++acc.contacts;
       acc.sliding += sliding;
       acc.maxOverlapRatio = std::max(acc.maxOverlapRatio, delta / std::min(ri, rj));
-      acc.maxKOverM = std::max(acc.maxKOverM, std::max(kn, 3.5 * kt) * (arr.im[i] + arr.im[j]));
+      acc.maxKOverM = std::max(acc.maxKOverM, std::max(kn, 3.5 * kt) * (pass[i].invMass + pass[j].invMass));
       if constexpr (kEnergy) {
         acc.elasticN += kernels::hertzEnergy(fe, delta);
         acc.elasticT += storedT;

@@ -12,7 +12,7 @@
 
 namespace fl {
 
-// What the contact pass reads of one particle, in one 64-byte line (issue 6): the pass visits each partner
+// What the contact passes read of one particle, in one 64-byte line (issue 6): the pass visits each partner
 // through its index, and six separate arrays cost it up to six lines per partner. A copy of the store's
 // values, written by the drift for every particle and refilled whole when positions are wrapped or masses
 // change (Simulation::packPassParticles); the store stays the one owner of the state.

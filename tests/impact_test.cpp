@@ -1,6 +1,7 @@
 // Two-particle impacts (verification ladder §1): Chung & Ooi (2011) test 1 peak overlap, peak force and
 // contact time against Hertz's closed forms; exit speed = entry speed without damping; oblique impact in
-// gross sliding against the rigid-body limit; energy never gained; momentum conserved.
+// gross sliding against the rigid-body limit; energy never gained; momentum conserved. Also: a sliding pair's
+// force follows its own materials' E* and friction, and a friction changed during the run.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,9 +1,9 @@
 // The validation build's invariant checks hold on a real compressed packing and catch corruption.
 #include <gtest/gtest.h>
 
+#include "core/binary_io.hpp"
 #include "core/errors.hpp"
 #include "core/gas_generator.hpp"
-#include "core/binary_io.hpp"
 #include "core/invariants.hpp"
 
 using namespace fl;
