@@ -25,6 +25,7 @@ set -euo pipefail
 steps=20000
 repeats=5
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+. "$root/bench/common.sh"
 build="$root/build/perf"
 out="$root/build/bench-cache"
 while [[ $# -gt 0 ]]; do
@@ -53,10 +54,7 @@ lmp_version="$(dpkg -s lammps | sed -n 's/^Version: //p')"
 
 # ---- 2.-3. FabricLab ---------------------------------------------------------------------------------
 bench="$build/bench/bench_dense"
-if [[ ! -x "$bench" ]]; then
-  cmake -S "$root" -B "$build" -DFL_BUILD_GUI=OFF -DFL_BUILD_TESTS=OFF -DCMAKE_BUILD_TYPE=Release >/dev/null
-  cmake --build "$build" -j2 --target bench_dense >/dev/null
-fi
+build_bench "$root" "$build" bench_dense
 mkdir -p "$out"
 data="$out/dense4000_318kPa.data"
 work="$(mktemp -d)"
@@ -102,7 +100,6 @@ print           "END p=\$(c_pv:%.12g) Z=\$(v_Z:%.12g)"
 EOF
 
 # ---- 5. the pairs ----------------------------------------------------------------------------------
-median() { sort -g | awk '{a[NR]=$1} END {if (NR%2) print a[(NR+1)/2]; else print (a[NR/2]+a[NR/2+1])/2}'; }
 fabriclab_rate() {  # threads -> particle-steps/s of one run, thread t on core t like MPI's rank r on core r
   OMP_PLACES=cores OMP_PROC_BIND=close "$bench" --cache "$out/dense4000_318kPa.state" --steps "$steps" --repeats 1 --threads "$1" >"$work/fl$1.txt" ||
     { cat "$work/fl$1.txt" >&2; die "FabricLab failed on $1 thread(s)"; }

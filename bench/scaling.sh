@@ -9,6 +9,7 @@
 # Usage: bench/scaling.sh [--build DIR] [--threads 1,2] [--particle-steps 2e8] [--rounds 3]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
+. "$root/bench/common.sh"
 build="$root/build/perf"
 threads="1,2"
 psteps="2e8"
@@ -23,14 +24,10 @@ while [ $# -gt 0 ]; do
   esac
 done
 bench="$build/bench/bench_dense"
-if [ ! -x "$bench" ]; then
-  cmake -S "$root" -B "$build" -DFL_BUILD_GUI=OFF -DFL_BUILD_TESTS=OFF -DCMAKE_BUILD_TYPE=Release >/dev/null
-  cmake --build "$build" -j2 --target bench_dense >/dev/null
-fi
+build_bench "$root" "$build" bench_dense
 cache="$root/build/bench-cache/dense4000_318kPa.state"  # shared with lammps_side_by_side.sh
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
-median() { sort -g | awk '{a[NR]=$1} END {if (NR%2) print a[(NR+1)/2]; else print (a[NR/2]+a[NR/2+1])/2}'; }
 tiles="1,1,1 2,2,2 4,4,4 6,6,7"
 : >"$out/runs.txt"  # N threads rate ns bytes, one line per run
 for ((r = 1; r <= rounds; ++r)); do

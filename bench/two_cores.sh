@@ -12,6 +12,7 @@
 #   bench/two_cores.sh [--build DIR] [--rounds 5] [--steps 5000]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
+. "$root/bench/common.sh"
 build="$root/build/perf"
 rounds=5
 steps=5000
@@ -25,10 +26,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 [ "$(nproc)" -ge 2 ] || { echo "two_cores.sh: needs 2 CPUs (nproc = $(nproc))" >&2; exit 2; }
-if [ ! -x "$build/bench/bench_dense" ] || [ ! -x "$build/bench/core_to_core" ]; then
-  cmake -S "$root" -B "$build" -DFL_BUILD_GUI=OFF -DFL_BUILD_TESTS=OFF -DCMAKE_BUILD_TYPE=Release >/dev/null
-  cmake --build "$build" -j2 --target bench_dense core_to_core >/dev/null
-fi
+build_bench "$root" "$build" bench_dense core_to_core
 cache="$root/build/bench-cache/dense4000_318kPa.state"  # shared with lammps_side_by_side.sh
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
@@ -37,7 +35,6 @@ rate() {  # [taskset cpu|-] threads -> particle-steps/s of one run
   (cd "$root" && "${pin[@]}" "$build/bench/bench_dense" --cache "$cache" --threads "$2" --steps "$steps" --repeats 1) |
     sed -n "s/^result: threads=$2 rate=\([^ ]*\).*/\1/p"
 }
-median() { sort -g | awk '{a[NR]=$1} END {if (NR%2) print a[(NR+1)/2]; else print (a[NR/2]+a[NR/2+1])/2}'; }
 rate - 1 >/dev/null  # prepares the cached packing if missing
 printf '%-6s %12s %12s %12s %12s %12s %10s %10s %9s\n' round "line [ns]" "1T cpu0" "1T cpu1" "both, cpu0" "both, cpu1" \
   "2 threads" "ceiling" "reached"
