@@ -13,8 +13,8 @@
 namespace fl {
 
 namespace {
-// What both contact passes read and write: the arrays as plain pointers for the OpenMP loops, the cell's
-// H and L, the time step and the pair count. The particles' x, r, v and 1/m come from their one-line copy
+// What both contact passes read and write: the arrays as plain pointers for the OpenMP loops, the cell
+// and its L, the time step and the pair count. The particles' x, r, v and 1/m come from their one-line copy
 // (PassParticle, particle_store.hpp), omega and the material from the store.
 struct PassArrays {
   const PassParticle* pp;  // x, r, v, 1/m
@@ -25,21 +25,21 @@ struct PassArrays {
   const Image* image;
   ContactHistory* hist;
   PairResult* result;
-  const Mat3& H;  // cell matrix
+  const PeriodicCell& cell;  // H, for the image shift H·image
   const Mat3& L;  // velocity gradient
   double dt;      // [s]
   std::size_t np;  // listed pairs
   PassArrays(const std::vector<PassParticle>& pass, const ParticleStore& p, ContactStore& c,
-             const PeriodicCell& cell, double timeStep)
+             const PeriodicCell& periodicCell, double timeStep)
       : pp(pass.data()), w(p.angVel.data()), mat(p.material.data()), first(c.first.data()),
         second(c.second.data()), image(c.image.data()), hist(c.history.data()), result(c.result.data()),
-        H(cell.matrix()), L(cell.velocityGradient()), dt(timeStep), np(c.size()) {}
+        cell(periodicCell), L(periodicCell.velocityGradient()), dt(timeStep), np(c.size()) {}
   std::size_t chunks(std::size_t chunk) const { return (np + chunk - 1) / chunk; }
   // l = x_j + H image - x_i for pair p = (i, j, image)
   Vec3 branch(std::size_t p, int i, int j) const {
     Vec3 d = pp[j].x - pp[i].x;
     const Image img = image[p];
-    if (!img.isZero()) d += H * img.vec().cast<double>();
+    if (!img.isZero()) d += cell.shift(img.vec());
     return d;
   }
 };

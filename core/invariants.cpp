@@ -43,7 +43,7 @@ void checkInvariants(const Simulation& sim) {
     if (std::abs(q.normal.norm() - 1.0) > 1e-12) violated("pair " + std::to_string(k) + " normal not unit");
     // the stored overlap and normal agree with the positions: l = x_j + H image - x_i = (R - delta) n
     const double R = p.radius[i] + p.radius[j];
-    const Vec3 l = p.pos[j] - p.pos[i] + sim.cell().matrix() * c.image[k].vec().cast<double>();
+    const Vec3 l = p.pos[j] - p.pos[i] + sim.cell().shift(c.image[k].vec());
     if (std::abs(l.norm() + q.overlap - R) > 1e-12 * R) violated("pair " + std::to_string(k) + " overlap");
     if ((l - (R - q.overlap) * q.normal).norm() > 1e-9 * R) violated("pair " + std::to_string(k) + " normal");
     const Vec3& ft = c.history[k].tangentialForce;
