@@ -1,7 +1,9 @@
 // Step 3 of the pipeline (simulation.hpp): the contact forces of every listed pair, written into the
-// contact store, with the Love–Weber stress, the diagnostics and (if tracked) the energies summed per fixed
-// chunk of pairs in the same pass. The default law runs vectorised over blocks of touching pairs
-// (contact_block.hpp); the Mindlin–Deresiewicz law one pair at a time (mindlin_deresiewicz.hpp).
+// contact store, with the Love–Weber stress, the axis stiffness, the contact and sliding counts and (if
+// tracked) the dissipated energies summed per fixed chunk of pairs in the same pass. The default law runs
+// vectorised over blocks of touching pairs (contact_block.hpp) and leaves the diagnostics' extremes and mean
+// force and the elastic energies to measureContacts, which reads them off the stored contacts when asked for;
+// the Mindlin–Deresiewicz law runs one pair at a time (mindlin_deresiewicz.hpp) and sums them all itself.
 #include <algorithm>
 #include <cmath>
 
@@ -118,6 +120,7 @@ void Simulation::contactPassBlocked() {
 #pragma omp for schedule(static)
     for (std::size_t k = 0; k < nchunks; ++k) {
       Chunk acc;
+      kernels::BlockSums sums;
       const std::size_t chunkEnd = std::min(np, (k + 1) * kChunk);
       for (std::size_t p0 = k * kChunk; p0 < chunkEnd; p0 += kernels::kBlockPairs) {
         const std::size_t p1 = std::min(chunkEnd, p0 + kernels::kBlockPairs);
@@ -178,34 +181,28 @@ void Simulation::contactPassBlocked() {
         b.count = m;
         // 2. the law across the block
         kernels::hertzMindlinBlock<kDamping, kEnergy>(b, arr.dt);
-        // 3. scatter, and the chunk's sums in pair order
+        // 3. the block's sums (vectorised), and the scatter of results and history
+        kernels::blockSums<kEnergy>(b, sums);
         for (int s = 0; s < m; ++s) {
           const std::size_t p = static_cast<std::size_t>(index[s]);
-          const Vec3 n(b.nx[s], b.ny[s], b.nz[s]);
-          const Vec3 f(b.fx[s], b.fy[s], b.fz[s]);
-          const Vec3 d(b.dx[s], b.dy[s], b.dz[s]);
           arr.hist[p].tangentialForce = Vec3(b.tx[s], b.ty[s], b.tz[s]);
           arr.hist[p].contactRadius = b.aPrev[s];
-          arr.result[p] = {f, n, b.delta[s], b.fn[s]};
-          acc.stress.noalias() += f * d.transpose();
-          acc.stiffness += b.kn[s] * n.cwiseProduct(d).cwiseAbs2();
-          acc.sumForce += b.fnorm[s];
-          acc.sliding += b.sliding[s] != 0.0;
-          acc.maxOverlapRatio = std::max(acc.maxOverlapRatio, b.overlapRatio[s]);
-          acc.maxKOverM = std::max(acc.maxKOverM, b.kOverM[s]);
-          if constexpr (kEnergy) {
-            acc.elasticN += b.elasticN[s];
-            acc.elasticT += b.storedT[s];
-            acc.friction += b.dissipatedT[s];
-            acc.damping += b.dampPower[s] * arr.dt;
-          }
+          arr.result[p] = {Vec3(b.fx[s], b.fy[s], b.fz[s]), Vec3(b.nx[s], b.ny[s], b.nz[s]), b.delta[s], b.fn[s]};
         }
         acc.contacts += static_cast<std::size_t>(m);
+      }
+      acc.stress = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(&sums.s[0][0]);
+      acc.stiffness = Vec3(sums.k[0], sums.k[1], sums.k[2]);
+      acc.sliding = static_cast<std::size_t>(sums.sliding);
+      if constexpr (kEnergy) {
+        acc.friction = sums.dissipatedT;
+        acc.damping = sums.dampPower * arr.dt;
       }
       chunks[k] = acc;
     }
   }
-  reduceContactChunks<kEnergy>(nchunks);
+  // the diagnostics' extremes and means and the elastic energies are read off the stored contacts on demand
+  reduceContactChunks<kEnergy, false>(nchunks);
 }
 
 template <bool kEnergy, bool kDamping, bool kAffine>
@@ -302,10 +299,10 @@ void Simulation::contactPassMindlinDeresiewicz() {
     }
     chunks[k] = acc;
   }
-  reduceContactChunks<kEnergy>(nchunks);
+  reduceContactChunks<kEnergy, true>(nchunks);
 }
 
-template <bool kEnergy>
+template <bool kEnergy, bool kMeasured>
 void Simulation::reduceContactChunks(std::size_t nchunks) {
   Mat3 s = Mat3::Zero();
   double eN = 0.0, eT = 0.0, fr = 0.0, dm = 0.0, sf = 0.0, mo = 0.0, mk = 0.0;
@@ -315,30 +312,68 @@ void Simulation::reduceContactChunks(std::size_t nchunks) {
     const Chunk& a = m_chunks[k];
     s += a.stress;
     stiff += a.stiffness;
-    eN += a.elasticN;
-    eT += a.elasticT;
-    fr += a.friction;
-    dm += a.damping;
-    sf += a.sumForce;
     nc += a.contacts;
     ns += a.sliding;
-    mo = std::max(mo, a.maxOverlapRatio);
-    mk = std::max(mk, a.maxKOverM);
+    if constexpr (kEnergy) {
+      fr += a.friction;
+      dm += a.damping;
+    }
+    if constexpr (kMeasured) {
+      eN += a.elasticN;
+      eT += a.elasticT;
+      sf += a.sumForce;
+      mo = std::max(mo, a.maxOverlapRatio);
+      mk = std::max(mk, a.maxKOverM);
+    }
   }
   m_stressPrev = m_stress;
   m_stress = s / m_cell.volume();
   if constexpr (kEnergy) {
-    m_energy.elasticNormal = eN;
-    m_energy.elasticTangential = eT;
     m_energy.frictionWork += fr;
     m_energy.contactDampingWork += dm;
   }
   m_diag.contacts = nc;
   m_diag.sliding = ns;
-  m_diag.meanContactForce = nc ? sf / static_cast<double>(nc) : 0.0;
-  m_diag.maxOverlapRatio = mo;
-  m_diag.maxStiffnessOverMass = mk;
   m_diag.axisStiffness = stiff / m_cell.volume();
+  m_contactsMeasured = kMeasured;
+  if constexpr (kMeasured) {
+    m_diag.meanContactForce = nc ? sf / static_cast<double>(nc) : 0.0;
+    m_diag.maxOverlapRatio = mo;
+    m_diag.maxStiffnessOverMass = mk;
+    if constexpr (kEnergy) {
+      m_elasticNormal = eN;
+      m_elasticTangential = eT;
+    }
+  }
+}
+
+void Simulation::measureContacts() const {
+  if (m_contactsMeasured) return;
+  // The default law's pass leaves these to be read off the stored contacts: the same formulas as the law
+  // (contact_kernels.hpp), from the overlap, force and history of each touching pair after the last pass.
+  // Serial, in pair order: the same bits for any thread count.
+  double sumForce = 0.0, maxOverlap = 0.0, maxKOverM = 0.0, elasticN = 0.0, elasticT = 0.0;
+  const ContactStore& c = m_c;
+  for (std::size_t p = 0; p < c.size(); ++p) {
+    const PairResult& q = c.result[p];
+    if (!(q.overlap > 0.0)) continue;
+    const int i = c.first[p], j = c.second[p];
+    const PairParams& pp = m_pairs(m_p.material[i], m_p.material[j]);
+    const double a = c.history[p].contactRadius;  // of this step
+    const double kn = kernels::hertzStiffness(pp.effYoung, a), kt = kernels::mindlinStiffness(pp.effShear, a);
+    sumForce += q.force.norm();
+    maxOverlap = std::max(maxOverlap, q.overlap / std::min(m_p.radius[i], m_p.radius[j]));
+    maxKOverM = std::max(maxKOverM, std::max(kn, 3.5 * kt) * (m_p.invMass[i] + m_p.invMass[j]));
+    elasticN += kernels::hertzEnergy(kernels::hertzForce(pp.effYoung, a, q.overlap), q.overlap);
+    if (kt > 0.0) elasticT += c.history[p].tangentialForce.squaredNorm() * (0.5 / kt);
+  }
+  const std::size_t nc = m_diag.contacts;
+  m_diag.meanContactForce = nc ? sumForce / static_cast<double>(nc) : 0.0;
+  m_diag.maxOverlapRatio = maxOverlap;
+  m_diag.maxStiffnessOverMass = maxKOverM;
+  m_elasticNormal = elasticN;
+  m_elasticTangential = elasticT;
+  m_contactsMeasured = true;
 }
 
 }  // namespace fl

@@ -345,12 +345,20 @@ double Runner::stageProgress() const {
 }
 
 // ---- guards (issue: numerical stability) -----------------------------------------------------------
-// O(1) per step: non-finite stress or cell, runaway overlap.
+// O(1) per step: non-finite stress or cell.
 void Runner::checkEveryStep() {
   const Simulation& sim = *m_sim;
   const Mat3& s = sim.contactStress();
   if (!s.allFinite() || !sim.cell().matrix().allFinite())
     blowUp("NaN/Inf in the stress or the cell", "reduce numerics.time_step_factor or enable guards.adaptive_time_step");
+}
+
+// Every check interval: runaway overlap; the time step follows the contact stiffness; energy must not be
+// created. The overlap and the stiffness are read off the stored contacts (Simulation::diagnostics), O(pairs),
+// so not every step.
+void Runner::checkPeriodically() {
+  Simulation& sim = *m_sim;
+  const GuardSettings& g = m_scene.guards;
   const double ov = sim.diagnostics().maxOverlapRatio;
   if (!(ov <= m_scene.guards.maxOverlapRatio)) {
     std::ostringstream o;
@@ -359,12 +367,6 @@ void Runner::checkEveryStep() {
     blowUp(o.str(), "the particles are too soft for this stress or the loading too fast: raise material.shear_modulus, "
                     "lower the target stress or the strain rate, or raise guards.max_overlap_ratio if intended");
   }
-}
-
-// Every check interval: the time step follows the contact stiffness; energy must not be created.
-void Runner::checkPeriodically() {
-  Simulation& sim = *m_sim;
-  const GuardSettings& g = m_scene.guards;
   if (g.adaptiveTimeStep) {
     const double limit = g.stiffnessSafety * sim.stiffnessTimeStep();
     const double want = std::min(m_configuredTimeStep, limit);

@@ -146,7 +146,8 @@ std::vector<SchemaField> makeSchema() {
   s.push_back(num("guards", "stiffness_safety", "-", "0.35", 0, 1, true, false,
                   "Fraction of the stiffness-based critical step allowed for dt."));
   s.push_back(num("guards", "max_overlap_ratio", "-", "0.05", 0, 1, true, false,
-                  "Stop (with a diagnostic checkpoint) when an overlap exceeds this fraction of the smaller radius."));
+                  "Stop (with a diagnostic checkpoint) when an overlap exceeds this fraction of the smaller radius "
+                  "(checked every output.check_interval steps)."));
   s.push_back(num("guards", "max_energy_error", "-", "0.25", 0, 1e6, true, false,
                   "Stop when the energy balance error exceeds this (energy created: the integration is unstable)."));
   s.push_back(num("guards", "warn_inertial_number", "-", "1e-3", 0, 1e6, true, false,

@@ -328,6 +328,9 @@ Mat3 Simulation::kineticStress() const {
 }
 
 const EnergyLedger& Simulation::energy() {
+  measureContacts();
+  m_energy.elasticNormal = m_elasticNormal;
+  m_energy.elasticTangential = m_elasticTangential;
   double k = 0.0;
   for (std::size_t i = 0; i < m_p.size(); ++i)
     k += 0.5 * (m_p.vel[i].squaredNorm() / m_p.invMass[i] + m_p.angVel[i].squaredNorm() / m_p.invInertia[i]);
@@ -336,15 +339,17 @@ const EnergyLedger& Simulation::energy() {
 }
 
 double Simulation::unbalancedForceRatio() const {
-  if (m_diag.contacts == 0 || m_diag.meanContactForce <= 0.0) return 0.0;
+  const ContactDiagnostics& d = diagnostics();
+  if (d.contacts == 0 || d.meanContactForce <= 0.0) return 0.0;
   double s = 0.0;
   for (const Vec3& f : m_p.force) s += f.norm();
-  return s / static_cast<double>(m_p.size()) / m_diag.meanContactForce;
+  return s / static_cast<double>(m_p.size()) / d.meanContactForce;
 }
 
 double Simulation::stiffnessTimeStep() const {
-  if (m_diag.maxStiffnessOverMass <= 0.0) return std::numeric_limits<double>::infinity();
-  return 2.0 / std::sqrt(m_diag.maxStiffnessOverMass);
+  const double kOverM = diagnostics().maxStiffnessOverMass;
+  if (kOverM <= 0.0) return std::numeric_limits<double>::infinity();
+  return 2.0 / std::sqrt(kOverM);
 }
 
 }  // namespace fl

@@ -4,8 +4,10 @@
 //   1. drift      half kick v += dt/2 a, x = Phi x + dt v', cell H = Phi H (Phi = exp(L dt))
 //   2. neighbours rebuild the Verlet list when a displacement or the cell strain may exceed the skin
 //   3. contacts   Hertz–Mindlin forces for every pair, written into the contact store, with the
-//                 Love–Weber stress and (if tracked) energies summed in the same pass; the tangential law
-//                 (numerics.tangentialModel) is a template parameter chosen once per pass
+//                 Love–Weber stress and (if tracked) the dissipated energies summed in the same pass; the
+//                 tangential law (numerics.tangentialModel) is a template parameter chosen once per pass.
+//                 What only measurements read (the diagnostics' extremes, the elastic energies) is read off
+//                 the stored contacts when asked for, not computed every step
 //   4. kick       forces gathered per particle in a fixed order, half kick v += dt/2 a
 //   5. control    the cell controller (if any) sets L for the next step
 // Deterministic: every reduction is over fixed-size chunks summed in chunk order, and forces are gathered
@@ -43,7 +45,9 @@ struct StageProfile {
   double total() const;
 };
 
-// Per-step diagnostics gathered in the force pass (cheap).
+// Diagnostics of the last force pass. The default law's pass sums the counts and the axis stiffness; the
+// extremes and the mean force are read off the stored contacts when first asked for after a step
+// (Simulation::diagnostics), so a step that nobody measures does not pay for them.
 struct ContactDiagnostics {
   double maxOverlapRatio = 0.0;   // max delta / min(r_i, r_j) [-]
   double maxStiffnessOverMass = 0.0;  // max (k_n or 3.5 k_t) / m* [1/s^2]
@@ -89,9 +93,12 @@ class Simulation {
   // measures read from stored data
   const Mat3& contactStress() const { return m_stress; }  // [Pa], compression positive
   Mat3 kineticStress() const;                             // (1/V) sum m v' v' [Pa]
-  const EnergyLedger& energy();                           // refreshes the kinetic term
+  const EnergyLedger& energy();  // refreshes the kinetic term and reads the elastic ones off the contacts
   double unbalancedForceRatio() const;  // mean |F_i| / mean |f_c|
-  const ContactDiagnostics& diagnostics() const { return m_diag; }
+  const ContactDiagnostics& diagnostics() const {
+    measureContacts();
+    return m_diag;
+  }
   const StageProfile& profile() const { return m_profile; }
   // Heap bytes held by the state (particle and pair arrays by capacity, history, adjacency, reduction
   // chunks); the neighbour grid is a temporary of each rebuild and not counted.
@@ -146,8 +153,13 @@ class Simulation {
   template <bool kEnergy, bool kDamping, bool kAffine>
   void contactPassMindlinDeresiewicz();
   // Sums the pass's chunk partials in chunk order into the stress, energies and diagnostics.
-  template <bool kEnergy>
+  // kMeasured: the pass summed the diagnostics' extremes and means and the elastic energies itself (the
+  // Mindlin–Deresiewicz pass); else they are left to measureContacts.
+  template <bool kEnergy, bool kMeasured>
   void reduceContactChunks(std::size_t nchunks);
+  // The diagnostics' extremes and mean force and the elastic energies of the last pass, read off the stored
+  // contacts (results and history), once per pass and only when asked for (contact_pass.cpp).
+  void measureContacts() const;
   // Sizes the Mindlin–Deresiewicz history array for the selected law (empty for the default law; when
   // switching to it, fresh histories start from the stored normal forces).
   void syncTangentialHistory();
@@ -174,8 +186,10 @@ class Simulation {
 
   Mat3 m_stress = Mat3::Zero();
   Mat3 m_stressPrev = Mat3::Zero();
-  EnergyLedger m_energy;
-  ContactDiagnostics m_diag;
+  EnergyLedger m_energy;  // its elastic terms are filled from m_elasticNormal/Tangential by energy()
+  mutable ContactDiagnostics m_diag;
+  mutable double m_elasticNormal = 0.0, m_elasticTangential = 0.0;  // [J], of the last pass
+  mutable bool m_contactsMeasured = false;  // m_diag and the elastic energies are of the last pass
   StageProfile m_profile;
   // Fixed reduction block (pairs or particles): results are independent of the thread count. Small enough
   // that 2 threads share ~60 blocks of a 4000-sphere packing evenly, large enough to amortise a block's sums.

@@ -102,7 +102,11 @@ void Simulation::saveState(BinaryWriter& w) const {
   w.put(m_maxDisp2);
   putMat(w, m_stress);
   putMat(w, m_stressPrev);
-  w.put(m_energy);
+  measureContacts();  // the ledger and the diagnostics of the last pass, whole
+  EnergyLedger ledger = m_energy;
+  ledger.elasticNormal = m_elasticNormal;
+  ledger.elasticTangential = m_elasticTangential;
+  w.put(ledger);
   w.put(m_diag);
 }
 
@@ -222,6 +226,9 @@ Simulation Simulation::restoreState(BinaryReader& r) {
   s.m_stressPrev = getMat(r, "previous stress");
   s.m_energy = r.get<EnergyLedger>("energy ledger");
   s.m_diag = r.get<ContactDiagnostics>("diagnostics");
+  s.m_elasticNormal = s.m_energy.elasticNormal;
+  s.m_elasticTangential = s.m_energy.elasticTangential;
+  s.m_contactsMeasured = true;
   if (!(s.m_dt > 0.0)) r.fail("time step must be > 0");
   // friction may have been changed during the run: the materials carry the current value
   s.m_pairs = PairTable(s.m_materials, s.m_num.restitution);
@@ -231,6 +238,7 @@ Simulation Simulation::restoreState(BinaryReader& r) {
 }
 
 void Simulation::reconfigure(const Material& material, const NumericsSettings& numerics) {
+  measureContacts();  // of the last pass, with the moduli it used
   numerics.validate();
   if (!isTangentialModel(numerics.tangentialModel))
     throw InputError("reconfigure: unknown numerics.tangential_model; allowed: " + tangentialModelList());
