@@ -186,13 +186,17 @@ int checkResults(const fs::path& dir, std::map<std::string, std::string>& before
   return checkpoints;
 }
 
-fs::path newestCheckpoint(const fs::path& dir) {
+// The checkpoint of dir with the most steps; unfinishedOnly: of those with stages left to run (a run killed
+// after its last stage's checkpoint, or one that finished, holds a checkpoint with nothing left).
+fs::path newestCheckpoint(const fs::path& dir, bool unfinishedOnly = false) {
   fs::path best;
   long bestStep = -1;
   if (!fs::exists(dir / "checkpoints")) return best;
   for (const auto& e : fs::directory_iterator(dir / "checkpoints")) {
     if (e.path().extension() != ".ckpt") continue;
-    const long step = fl::Runner::fromCheckpoint(e.path().string()).simulation().stepCount();
+    const fl::Runner r = fl::Runner::fromCheckpoint(e.path().string());
+    if (unfinishedOnly && r.finished()) continue;
+    const long step = r.simulation().stepCount();
     if (step > bestStep) bestStep = step, best = e.path();
   }
   return best;
@@ -266,10 +270,10 @@ TEST_F(CrashSafety, KillAnywhereLosesNothingAndRestarts) {
     maxCheckpoints = std::max(maxCheckpoints, n);
     ++survived;
   }
-  // The newest checkpoint restarts and runs on in-process.
-  fs::path ck = newestCheckpoint(results);
-  if (ck.empty()) ck = newestCheckpoint(lastFinished);  // the last run finished before its kill
-  ASSERT_FALSE(ck.empty()) << "no checkpoint was ever written";
+  // The newest checkpoint with stages left restarts and runs on in-process.
+  fs::path ck = newestCheckpoint(results, true);
+  if (ck.empty()) ck = newestCheckpoint(lastFinished, true);  // the last run finished before its kill
+  ASSERT_FALSE(ck.empty()) << "no checkpoint with stages left was ever written";
   fl::Runner r = fl::Runner::fromCheckpoint(ck.string());
   const long step0 = r.simulation().stepCount();
   EXPECT_NO_THROW(r.advance(200));
