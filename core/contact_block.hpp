@@ -9,7 +9,8 @@
 // including new, sliding, unloading and damped contacts. g++ vectorises it only with -fno-trapping-math
 // (CMakeLists.txt): without AVX-512's masks the guarded quotients would otherwise stay branches.
 // Stateless: inputs and history in, results and updated history out; the caller gathers and scatters.
-// Per step it computes what every step needs: forces, history, and the terms of the stress, the axis
+// Per step it computes what every step needs: forces and their moments n x f (the kick's torques), history,
+// and the terms of the stress, the axis
 // stiffness, the sliding count and the energy ledger's dissipation (blockSums). The extreme and mean values
 // of ContactDiagnostics and the stored elastic energies are read off the stored contacts when asked for
 // (Simulation::measureContacts), so they cost the law no square root or division.
@@ -51,6 +52,7 @@ struct alignas(64) PairBlock {
   alignas(64) double delta[kBlockPairs];                                 // overlap [m]
   alignas(64) double fn[kBlockPairs];                                    // F_n >= 0 [N]
   alignas(64) double fx[kBlockPairs], fy[kBlockPairs], fz[kBlockPairs];  // total force on j [N]
+  alignas(64) double mx[kBlockPairs], my[kBlockPairs], mz[kBlockPairs];  // its moment n x f [N]
   alignas(64) double kn[kBlockPairs];       // 2 E* a [N/m]
   // ---- between the law's two loops
   alignas(64) double vtx[kBlockPairs], vty[kBlockPairs], vtz[kBlockPairs];  // tangential velocity [m/s]
@@ -182,9 +184,13 @@ inline void hertzMindlinBlock(PairBlock& b, double dt) {
       ftz += dz;
       dampPower = b.dampPower[s] - (dx * vtx + dy * vty + dz * vtz);
     }
-    b.fx[s] = fn * nx + ftx;
-    b.fy[s] = fn * ny + fty;
-    b.fz[s] = fn * nz + ftz;
+    const double fx = fn * nx + ftx, fy = fn * ny + fty, fz = fn * nz + ftz;
+    b.fx[s] = fx;
+    b.fy[s] = fy;
+    b.fz[s] = fz;
+    b.mx[s] = ny * fz - nz * fy;
+    b.my[s] = nz * fx - nx * fz;
+    b.mz[s] = nx * fy - ny * fx;
     b.sliding[s] = slide ? 1.0 : 0.0;
     // the energy terms stay computed in place above: g++ 12 stopped vectorising the loop when they were moved
     // into this block

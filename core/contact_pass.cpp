@@ -187,7 +187,7 @@ void Simulation::contactPassBlocked() {
           const std::size_t p = static_cast<std::size_t>(index[s]);
           arr.hist[p].tangentialForce = Vec3(b.tx[s], b.ty[s], b.tz[s]);
           arr.hist[p].contactRadius = b.aPrev[s];
-          arr.result[p] = {Vec3(b.fx[s], b.fy[s], b.fz[s]), Vec3(b.nx[s], b.ny[s], b.nz[s]), b.delta[s], b.fn[s]};
+          arr.result[p] = {Vec3(b.fx[s], b.fy[s], b.fz[s]), Vec3(b.mx[s], b.my[s], b.mz[s]), b.delta[s], b.fn[s]};
         }
         acc.contacts += static_cast<std::size_t>(m);
       }
@@ -282,7 +282,7 @@ void Simulation::contactPassMindlinDeresiewicz() {
         }
       }
       const Vec3 f = fn * n + ft;
-      arr.result[p] = {f, n, delta, fn};
+      arr.result[p] = {f, n.cross(f), delta, fn};
       acc.stress.noalias() += f * d.transpose();
       acc.stiffness += kn * n.cwiseProduct(d).cwiseAbs2();
       acc.sumForce += f.norm();

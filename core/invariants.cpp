@@ -40,15 +40,17 @@ void checkInvariants(const Simulation& sim) {
     ++seen[j];
     if (!c.active(k)) continue;
     const PairResult& q = c.result[k];
-    if (std::abs(q.normal.norm() - 1.0) > 1e-12) violated("pair " + std::to_string(k) + " normal not unit");
-    // the stored overlap and normal agree with the positions: l = x_j + H image - x_i = (R - delta) n
+    // the stored overlap agrees with the positions: l = x_j + H image - x_i, |l| = R - delta; the moment is
+    // n x f with n = l / |l|
     const double R = p.radius[i] + p.radius[j];
-    const Vec3 l = p.pos[j] - p.pos[i] + sim.cell().shift(c.image[k].vec());
+    const Vec3 l = c.branch(k, p, sim.cell());
     if (std::abs(l.norm() + q.overlap - R) > 1e-12 * R) violated("pair " + std::to_string(k) + " overlap");
-    if ((l - (R - q.overlap) * q.normal).norm() > 1e-9 * R) violated("pair " + std::to_string(k) + " normal");
+    const Vec3 normal = l.normalized();
+    if ((q.moment - normal.cross(q.force)).norm() > 1e-9 * q.force.norm() + 1e-300)
+      violated("pair " + std::to_string(k) + " moment");
     const Vec3& ft = c.history[k].tangentialForce;
     // round-off of the projection scales with the contact's forces, not with |F_t| (which may be ~0)
-    if (std::abs(ft.dot(q.normal)) > 1e-9 * ft.norm() + 1e-12 * q.normalForce + 1e-300)
+    if (std::abs(ft.dot(normal)) > 1e-9 * ft.norm() + 1e-12 * q.normalForce + 1e-300)
       violated("pair " + std::to_string(k) + " tangential force out of the tangent plane");
     const double mu = sim.materials()[p.material[i]].friction;
     if (ft.norm() > mu * q.normalForce * (1 + 1e-9) + 1e-300)

@@ -92,10 +92,11 @@ FabricMeasures fabricImpl(ForEachNormal&& each) {
 }
 }  // namespace
 
-FabricMeasures fabricMeasures(const ContactStore& c) {
+FabricMeasures fabricMeasures(const Simulation& sim) {
+  const ContactStore& c = sim.contacts();
   return fabricImpl([&](auto&& use) {
     for (std::size_t p = 0; p < c.size(); ++p)
-      if (c.active(p)) use(c.result[p].normal);
+      if (c.active(p)) use(c.normal(p, sim.particles(), sim.cell()));
   });
 }
 

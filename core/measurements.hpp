@@ -47,7 +47,7 @@ struct FabricMeasures {
   double direction2D = 0.0;       // theta_a from the vertical in the projected fabric, [0, pi/2] [rad]
   std::size_t contacts = 0;
 };
-FabricMeasures fabricMeasures(const ContactStore& c);
+FabricMeasures fabricMeasures(const Simulation& sim);  // of the touching pairs' normals
 // The same for an explicit list of unit normals (used by tests and rose diagrams).
 FabricMeasures fabricFromNormals(const std::vector<Vec3>& normals);
 

@@ -458,7 +458,7 @@ Sample Runner::measure() {
   const ContactCounts z = contactCounts(sim);
   s.Z = z.coordination;
   s.Zm = z.mechanicalCoordination;
-  const FabricMeasures f = fabricMeasures(sim.contacts());
+  const FabricMeasures f = fabricMeasures(sim);
   s.a3D = f.anisotropy3D;
   s.a2D = f.anisotropy2D;
   const StageSpec* cur = currentStage();

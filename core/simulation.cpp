@@ -266,7 +266,7 @@ void Simulation::kickPass() {
     for (int i = static_cast<int>(k * kChunk); i < end; ++i) {
       // Pairs that do not touch hold a zero force (the contact pass keeps it so), so they are gathered
       // without a branch: adding zero changes nothing but the sign of a zero. Scalar sums: with Eigen
-      // temporaries g++ spilled the cross product as two 8-byte stores read back as one 16-byte load, a
+      // temporaries g++ spilled a cross product as two 8-byte stores read back as one 16-byte load, a
       // store-forwarding stall on the loop-carried torque (kick 5x slower).
       const double ri = rad[i];
       double fx = 0.0, fy = 0.0, fz = 0.0, tx = 0.0, ty = 0.0, tz = 0.0;
@@ -276,12 +276,11 @@ void Simulation::kickPass() {
         const int entry = adjEntry[e];
         const PairResult& c = res[entry >> 1];
         const double cfx = c.force.x(), cfy = c.force.y(), cfz = c.force.z();
-        const double nx = c.normal.x(), ny = c.normal.y(), nz = c.normal.z();
         // torque = -(r_self - delta/2) n x f on both particles (contact point on the pair axis)
         const double arm = ri - 0.5 * c.overlap;
-        tx -= arm * (ny * cfz - nz * cfy);
-        ty -= arm * (nz * cfx - nx * cfz);
-        tz -= arm * (nx * cfy - ny * cfx);
+        tx -= arm * c.moment.x();
+        ty -= arm * c.moment.y();
+        tz -= arm * c.moment.z();
         // side 1 (second particle) receives +f, side 0 receives -f
         const double sign = static_cast<double>(((entry & 1) << 1) - 1);
         fx += sign * cfx;

@@ -11,9 +11,11 @@
 namespace fl {
 
 namespace {
+// 4: the contact results carry the moment n x f in place of the normal (PairResult).
 // 3: numerics carry the tangential model; the Mindlin–Deresiewicz history follows the contact history.
-// 2: read for compatibility (the default tangential law, no extra history).
-constexpr std::uint32_t kStateVersion = 3;
+// 2: read for compatibility (the default tangential law, no extra history); 2 and 3 give the moments from
+// their normals and forces.
+constexpr std::uint32_t kStateVersion = 4;
 
 // NumericsSettings as written by state version 2 (same members and order, no tangentialModel).
 struct NumericsSettingsV2 {
@@ -72,19 +74,19 @@ void Simulation::saveState(BinaryWriter& w) const {
   w.putVector(m_c.history);
   w.putVector(m_c.mdHistory);  // empty with the default tangential law
   {
-    // the results as the separate arrays of format versions 1-3 (the distance is derived: r_i + r_j - delta)
+    // the results as separate arrays (the distance is derived: r_i + r_j - delta)
     const std::size_t np = m_c.size();
-    std::vector<Vec3> normal(np), force(np);
+    std::vector<Vec3> moment(np), force(np);
     std::vector<double> overlap(np), distance(np), normalForce(np);
     for (std::size_t p = 0; p < np; ++p) {
       const PairResult& q = m_c.result[p];
-      normal[p] = q.normal;
+      moment[p] = q.moment;
       overlap[p] = q.overlap;
       distance[p] = q.overlap > 0.0 ? m_c.distance(p, m_p.radius) : 0.0;
       normalForce[p] = q.normalForce;
       force[p] = q.force;
     }
-    w.putVector(normal);
+    w.putVector(moment);
     w.putVector(overlap);
     w.putVector(distance);
     w.putVector(normalForce);
@@ -112,8 +114,8 @@ void Simulation::saveState(BinaryWriter& w) const {
 
 Simulation Simulation::restoreState(BinaryReader& r) {
   const auto version = r.get<std::uint32_t>("state version");
-  if (version != kStateVersion && version != 2)
-    r.fail("simulation state version " + std::to_string(version) + " is not supported (expected 2 or " +
+  if (version < 2 || version > kStateVersion)
+    r.fail("simulation state version " + std::to_string(version) + " is not supported (expected 2 to " +
            std::to_string(kStateVersion) + ")");
   Simulation s;
   const auto nm = r.get<std::uint64_t>("material count");
@@ -185,17 +187,21 @@ Simulation Simulation::restoreState(BinaryReader& r) {
   c.image = r.getVector<Image>("pair image");
   c.history = r.getVector<ContactHistory>("contact history");
   if (version >= 3) c.mdHistory = r.getVector<MdHistory>("Mindlin-Deresiewicz history");
-  const auto normal = r.getVector<Vec3>("contact normals");
+  // version 4: the moments n x f; before: the normals
+  const auto normalOrMoment = r.getVector<Vec3>(version >= 4 ? "contact moments" : "contact normals");
   const auto overlap = r.getVector<double>("contact overlaps");
   const auto distance = r.getVector<double>("contact distances");  // derived data: length checked only
   const auto normalForce = r.getVector<double>("contact normal forces");
   const auto force = r.getVector<Vec3>("contact forces");
   const std::size_t np = c.first.size();
-  if (c.second.size() != np || c.image.size() != np || c.history.size() != np || normal.size() != np ||
+  if (c.second.size() != np || c.image.size() != np || c.history.size() != np || normalOrMoment.size() != np ||
       overlap.size() != np || distance.size() != np || normalForce.size() != np || force.size() != np)
     r.fail("contact arrays have inconsistent lengths");
   c.result.resize(np);
-  for (std::size_t q = 0; q < np; ++q) c.result[q] = {force[q], normal[q], overlap[q], normalForce[q]};
+  for (std::size_t q = 0; q < np; ++q) {
+    const Vec3 moment = version >= 4 ? normalOrMoment[q] : Vec3(normalOrMoment[q].cross(force[q]));
+    c.result[q] = {force[q], moment, overlap[q], normalForce[q]};
+  }
   const bool md = s.m_num.tangentialModel == TangentialModel::MindlinDeresiewicz;
   if (c.mdHistory.size() != (md ? np : 0))
     r.fail("the Mindlin-Deresiewicz history has " + std::to_string(c.mdHistory.size()) + " entries, expected " +

@@ -149,7 +149,7 @@ void writeContactsVtu(const std::string& path, const Simulation& sim) {
   for (std::size_t k : active) {
     const Vec3& xi = p.pos[static_cast<std::size_t>(c.first[k])];
     pts.push_back(xi);
-    pts.push_back(xi + c.branch(k, p.radius));  // towards j's image: lines across the boundary keep their length
+    pts.push_back(xi + c.branch(k, p, sim.cell()));  // towards j's image: lines across the boundary keep their length
   }
   std::string s;
   beginPiece(s, pts.size(), active.size());

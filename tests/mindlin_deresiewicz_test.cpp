@@ -314,7 +314,7 @@ Rebound obliqueImpact(TangentialModel model, double tanTheta, const Material& m,
         active = true;
         if (c.result[q].overlap > maxOverlap) {
           maxOverlap = c.result[q].overlap;
-          n = c.result[q].normal;
+          n = c.normal(q, sim.particles(), sim.cell());
         }
       }
     if (active) touched = true;

@@ -35,7 +35,7 @@ PairRun runPair(const Vec3& x1, const Vec3& d, const Mat3& L, int steps) {
   PairRun r{Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
   for (std::size_t k = 0; k < c.size(); ++k)
     if (c.active(k)) {
-      r.branch = c.branch(k, sim.particles().radius);
+      r.branch = c.branch(k, sim.particles(), sim.cell());
       r.force = c.result[k].force;
     }
   r.relVel = sim.particles().vel[1] - sim.particles().vel[0];

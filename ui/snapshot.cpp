@@ -70,7 +70,7 @@ void fillParticles(const Simulation& sim, Snapshot& out) {
     s.first = i;
     s.second = j;
     s.start = out.positions[static_cast<std::size_t>(i)];
-    s.branch = c.branch(k, p.radius);
+    s.branch = c.branch(k, p, cell);
     s.normalForce = c.result[k].normalForce;
     out.contacts.push_back(s);
     ++out.contactCounts[static_cast<std::size_t>(i)];
