@@ -6,6 +6,10 @@
 // the Mindlin–Deresiewicz law runs one pair at a time (mindlin_deresiewicz.hpp) and sums them all itself.
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include <omp.h>
 
 #include "contact_block.hpp"
 #include "contact_kernels.hpp"
@@ -35,7 +39,8 @@ struct PassArrays {
              const PeriodicCell& periodicCell, double timeStep)
       : pp(pass.data()), w(p.angVel.data()), mat(p.material.data()), first(c.first.data()),
         second(c.second.data()), image(c.image.data()), hist(c.history.data()), result(c.result.data()),
-        cell(periodicCell), L(periodicCell.velocityGradient()), dt(timeStep), np(c.size()) {}
+        cell(periodicCell), L(periodicCell.velocityGradient()), dt(timeStep), np(c.size()), n(p.size()) {}
+  std::size_t n;   // particles
   std::size_t chunks(std::size_t chunk) const { return (np + chunk - 1) / chunk; }
   // l = x_j + H image - x_i for pair p = (i, j, image)
   Vec3 branch(std::size_t p, int i, int j) const {
@@ -45,6 +50,15 @@ struct PassArrays {
     return d;
   }
 };
+
+// The first particle that a later thread than t (of nt) drifts: the drift's static split, as libgomp makes
+// it (contiguous runs, the first n % nt one longer); no such particle for the last thread.
+std::int32_t remotePartnersFrom(int t, int nt, std::size_t n) {
+  if (t + 1 >= nt) return std::numeric_limits<std::int32_t>::max();
+  const std::size_t q = n / static_cast<std::size_t>(nt), r = n % static_cast<std::size_t>(nt);
+  const std::size_t next = static_cast<std::size_t>(t + 1);
+  return static_cast<std::int32_t>(next * q + std::min(next, r));
+}
 }  // namespace
 
 void Simulation::computeContacts() {
@@ -117,6 +131,8 @@ void Simulation::contactPassBlocked() {
       std::fill_n(b.friction, kernels::kBlockPairs, pp.friction);
       std::fill_n(b.dampingRatio, kernels::kBlockPairs, pp.dampingRatio);
     }
+    const std::int32_t remoteFrom = remotePartnersFrom(omp_get_thread_num(), omp_get_num_threads(), arr.n);
+    const bool remote = static_cast<std::size_t>(remoteFrom) < arr.n;
 #pragma omp for schedule(static)
     for (std::size_t k = 0; k < nchunks; ++k) {
       Chunk acc;
@@ -124,19 +140,23 @@ void Simulation::contactPassBlocked() {
       const std::size_t chunkEnd = std::min(np, (k + 1) * kChunk);
       for (std::size_t p0 = k * kChunk; p0 < chunkEnd; p0 += kernels::kBlockPairs) {
         const std::size_t p1 = std::min(chunkEnd, p0 + kernels::kBlockPairs);
+        // the next block's partners that a later thread drifts: on this kind of VM a line last written by the
+        // other core arrives 50-200 ns late (docs/performance.md). Only those: with one thread, or for
+        // partners of its own, the prefetch cost ~15 % of a 1-thread step (loads and prefetches every pair).
+        if (remote)
+          for (std::size_t q = p1, qEnd = std::min(np, p1 + kernels::kBlockPairs); q < qEnd; ++q) {
+            const std::int32_t jn = arr.second[q];
+            if (jn >= remoteFrom) {
+              __builtin_prefetch(pass + jn);
+              __builtin_prefetch(arr.w + jn);
+            }
+          }
         // 1a. geometry of every listed pair: each is written to slot m, which advances only for a touching
         // pair; a pair whose contact opened goes to the stale list. No branch depends on the data (40 % of
         // the listed pairs do not touch: a branch on it was mispredicted about as often).
         int m = 0, stale = 0;
         for (std::size_t p = p0; p < p1; ++p) {
           const int i = arr.first[p], j = arr.second[p];
-          // prefetch the next block's partner particles: on this kind of VM a line last written by the other
-          // core (the partners across the threads' boundary) arrives ~200 ns late (docs/performance.md)
-          if (p + kernels::kBlockPairs < np) {
-            const int jn = arr.second[p + kernels::kBlockPairs];
-            __builtin_prefetch(pass + jn);
-            __builtin_prefetch(arr.w + jn);
-          }
           const Vec3 d = arr.branch(p, i, j);
           const double ri = pass[i].radius, rj = pass[j].radius;
           const double R = ri + rj;
