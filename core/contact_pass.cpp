@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 
 #include <omp.h>
 
@@ -51,14 +50,6 @@ struct PassArrays {
   }
 };
 
-// The first particle that a later thread than t (of nt) drifts: the drift's static split, as libgomp makes
-// it (contiguous runs, the first n % nt one longer); no such particle for the last thread.
-std::int32_t remotePartnersFrom(int t, int nt, std::size_t n) {
-  if (t + 1 >= nt) return std::numeric_limits<std::int32_t>::max();
-  const std::size_t q = n / static_cast<std::size_t>(nt), r = n % static_cast<std::size_t>(nt);
-  const std::size_t next = static_cast<std::size_t>(t + 1);
-  return static_cast<std::int32_t>(next * q + std::min(next, r));
-}
 }  // namespace
 
 void Simulation::computeContacts() {
@@ -131,8 +122,10 @@ void Simulation::contactPassBlocked() {
       std::fill_n(b.friction, kernels::kBlockPairs, pp.friction);
       std::fill_n(b.dampingRatio, kernels::kBlockPairs, pp.dampingRatio);
     }
-    const std::int32_t remoteFrom = remotePartnersFrom(omp_get_thread_num(), omp_get_num_threads(), arr.n);
-    const bool remote = static_cast<std::size_t>(remoteFrom) < arr.n;
+    // partners from this index on are drifted by a later thread (the drift's static split); none for the last
+    const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+    const bool remote = t + 1 < nt;
+    const auto remoteFrom = static_cast<std::int32_t>(remote ? staticBegin(t + 1, nt, arr.n) : arr.n);
 #pragma omp for schedule(static)
     for (std::size_t k = 0; k < nchunks; ++k) {
       Chunk acc;

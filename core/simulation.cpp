@@ -6,6 +6,8 @@
 #include <limits>
 #include <type_traits>
 
+#include <omp.h>
+
 #include "errors.hpp"
 #include "neighbor_search.hpp"
 
@@ -143,9 +145,12 @@ void Simulation::drift() {
   const Vec3* x0 = m_refPos.data();
   PassParticle* pass = m_pass.data();
   double maxd2 = 0.0;
-#pragma omp parallel for num_threads(m_num.threads) schedule(static) reduction(max : maxd2)
+#pragma omp parallel num_threads(m_num.threads) reduction(max : maxd2)
+  {
+  const bool prefetch = omp_get_thread_num() > 0;  // see kPrefetchAhead
+#pragma omp for schedule(static)
   for (int i = 0; i < n; ++i) {
-    if (i + kPrefetchAhead < n) {
+    if (prefetch && i + kPrefetchAhead < n) {
       __builtin_prefetch(x + i + kPrefetchAhead, 1);
       __builtin_prefetch(v + i + kPrefetchAhead, 1);
       __builtin_prefetch(w + i + kPrefetchAhead, 1);
@@ -165,6 +170,7 @@ void Simulation::drift() {
     pass[i].v = v[i];
     const Vec3 u = x[i] - Fref * x0[i];
     maxd2 = std::max(maxd2, u.squaredNorm());
+  }
   }
   m_maxDisp2 = maxd2;
 }
@@ -259,7 +265,13 @@ void Simulation::kickPass() {
   Vec3* w = m_p.angVel.data();
   const double* im = m_p.invMass.data();
   const double* ii = m_p.invInertia.data();
-#pragma omp parallel for num_threads(m_num.threads) schedule(static)
+  const std::size_t passChunks = (m_c.size() + kChunk - 1) / kChunk;
+#pragma omp parallel num_threads(m_num.threads)
+  {
+  // result lines of pairs below this entry were written by an earlier thread's pass (see kPrefetchEntries)
+  const auto remoteBelow = static_cast<std::int32_t>(
+      2 * kChunk * staticBegin(omp_get_thread_num(), omp_get_num_threads(), passChunks));
+#pragma omp for schedule(static)
   for (std::size_t k = 0; k < nchunks; ++k) {
     double work = 0.0;
     const int end = static_cast<int>(std::min<std::size_t>(n, (k + 1) * kChunk));
@@ -271,8 +283,9 @@ void Simulation::kickPass() {
       const double ri = rad[i];
       double fx = 0.0, fy = 0.0, fz = 0.0, tx = 0.0, ty = 0.0, tz = 0.0;
       for (int e = adjStart[i]; e < adjStart[i + 1]; ++e) {
-        // the result line kPrefetchEntries entries ahead (about 16 particles)
-        if (e + kPrefetchEntries < entries) __builtin_prefetch(res + (adjEntry[e + kPrefetchEntries] >> 1));
+        // the result line kPrefetchEntries entries ahead (about 16 particles), if another core wrote it
+        if (remoteBelow > 0 && e + kPrefetchEntries < entries && adjEntry[e + kPrefetchEntries] < remoteBelow)
+          __builtin_prefetch(res + (adjEntry[e + kPrefetchEntries] >> 1));
         const int entry = adjEntry[e];
         const PairResult& c = res[entry >> 1];
         const double cfx = c.force.x(), cfy = c.force.y(), cfz = c.force.z();
@@ -302,6 +315,7 @@ void Simulation::kickPass() {
       w[i] += (h * ii[i]) * t;
     }
     m_chunks[k].localDamping = work;
+  }
   }
   if constexpr (kLocalDamping) {
     if (m_num.trackEnergy)

@@ -16,6 +16,7 @@
 // on j and l_c the branch vector from i to j.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <memory>
 #include <string>
@@ -196,12 +197,23 @@ class Simulation {
   static constexpr std::size_t kChunk = 256;
   // How far ahead (particles) the drift prefetches the lines it will write: lines last read by the other
   // core arrive ~200 ns late on this kind of VM, ~25 particles' work at ~8 ns each (docs/performance.md,
-  // "per-thread busy time": 4 ahead left the second thread's drift 50 % slower than the first's).
+  // "per-thread busy time": 4 ahead left the second thread's drift 50 % slower than the first's). Only the
+  // threads after the first prefetch: the first thread's particles are read by no other thread's pass.
   static constexpr int kPrefetchAhead = 32;
   // How far ahead (adjacency entries) the kick prefetches the result lines it will gather: ~16 particles of
   // the dense packing's ~8.7 listed pairs each, ~200 ns of the kick's work (35 entries left the second
-  // thread, which gathers the results the first wrote across the boundary, 20 % slower).
+  // thread, which gathers the results the first wrote across the boundary, 20 % slower). Only lines an
+  // earlier thread's pass wrote: with one thread, prefetching every entry cost 2-7 % of a step.
   static constexpr int kPrefetchEntries = 140;
+ public:
+  // Where thread t of nt starts in a loop of `count` iterations under schedule(static): contiguous runs, the
+  // first count % nt one longer (libgomp and libomp alike). Only prefetch decisions use it, never the bits.
+  static std::size_t staticBegin(int t, int nt, std::size_t count) {
+    const std::size_t q = count / static_cast<std::size_t>(nt), r = count % static_cast<std::size_t>(nt);
+    const std::size_t k = static_cast<std::size_t>(t);
+    return k * q + std::min(k, r);
+  }
+ private:
   // Partial sums of one fixed block of pairs (or particles), reduced in block order.
   struct Chunk {
     Mat3 stress = Mat3::Zero();  // sum f (x) l [N m]
