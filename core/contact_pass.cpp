@@ -122,10 +122,12 @@ void Simulation::contactPassBlocked() {
       std::fill_n(b.friction, kernels::kBlockPairs, pp.friction);
       std::fill_n(b.dampingRatio, kernels::kBlockPairs, pp.dampingRatio);
     }
-    // partners from this index on are drifted by a later thread (the drift's static split); none for the last
+    // the partners to prefetch: all of them when the state outgrows the caches (kPrefetchAllFrom), else those
+    // from the first particle a later thread drifts on (the drift's static split; none for the last thread)
     const int t = omp_get_thread_num(), nt = omp_get_num_threads();
-    const bool remote = t + 1 < nt;
-    const auto remoteFrom = static_cast<std::int32_t>(remote ? staticBegin(t + 1, nt, arr.n) : arr.n);
+    const bool remote = t + 1 < nt || arr.n >= kPrefetchAllFrom;
+    const auto remoteFrom = static_cast<std::int32_t>(
+        arr.n >= kPrefetchAllFrom ? 0 : (t + 1 < nt ? staticBegin(t + 1, nt, arr.n) : arr.n));
 #pragma omp for schedule(static)
     for (std::size_t k = 0; k < nchunks; ++k) {
       Chunk acc;
@@ -133,9 +135,10 @@ void Simulation::contactPassBlocked() {
       const std::size_t chunkEnd = std::min(np, (k + 1) * kChunk);
       for (std::size_t p0 = k * kChunk; p0 < chunkEnd; p0 += kernels::kBlockPairs) {
         const std::size_t p1 = std::min(chunkEnd, p0 + kernels::kBlockPairs);
-        // the next block's partners that a later thread drifts: on this kind of VM a line last written by the
-        // other core arrives 50-200 ns late (docs/performance.md). Only those: with one thread, or for
-        // partners of its own, the prefetch cost ~15 % of a 1-thread step (loads and prefetches every pair).
+        // the next block's partners that are not in cache: the lines a later thread drifts (on this kind of VM
+        // a line last written by the other core arrives 50-200 ns late, docs/performance.md), or all when the
+        // state outgrows the caches (a whole sweep lies between a line's drift and its pass). At 4000 spheres
+        // (3 MB) prefetching every partner cost ~15 % of a 1-thread step.
         if (remote)
           for (std::size_t q = p1, qEnd = std::min(np, p1 + kernels::kBlockPairs); q < qEnd; ++q) {
             const std::int32_t jn = arr.second[q];

@@ -268,9 +268,12 @@ void Simulation::kickPass() {
   const std::size_t passChunks = (m_c.size() + kChunk - 1) / kChunk;
 #pragma omp parallel num_threads(m_num.threads)
   {
-  // result lines of pairs below this entry were written by an earlier thread's pass (see kPrefetchEntries)
+  // result lines of pairs below this entry were written by an earlier thread's pass, or all are out of
+  // cache (see kPrefetchEntries)
   const auto remoteBelow = static_cast<std::int32_t>(
-      2 * kChunk * staticBegin(omp_get_thread_num(), omp_get_num_threads(), passChunks));
+      static_cast<std::size_t>(n) >= kPrefetchAllFrom
+          ? 2 * m_c.size()
+          : 2 * kChunk * staticBegin(omp_get_thread_num(), omp_get_num_threads(), passChunks));
 #pragma omp for schedule(static)
   for (std::size_t k = 0; k < nchunks; ++k) {
     double work = 0.0;

@@ -195,15 +195,23 @@ class Simulation {
   // Fixed reduction block (pairs or particles): results are independent of the thread count. Small enough
   // that 2 threads share ~60 blocks of a 4000-sphere packing evenly, large enough to amortise a block's sums.
   static constexpr std::size_t kChunk = 256;
+  // Software prefetches pay for lines that are not in cache: those the other core last wrote, and all of them
+  // once the state outgrows the caches. From this many particles (~7.6 MB of state at ~760 bytes each) the
+  // contact pass prefetches every partner and the kick every result line: with one thread, 32 000 spheres
+  // (24 MB) ran 3.2e6 particle-steps/s without and 4.5e6 with the partners' prefetch, 4000 spheres (3 MB)
+  // ~15 % faster without (Zen 3, docs/performance.md).
+  static constexpr std::size_t kPrefetchAllFrom = 10000;
   // How far ahead (particles) the drift prefetches the lines it will write: lines last read by the other
   // core arrive ~200 ns late on this kind of VM, ~25 particles' work at ~8 ns each (docs/performance.md,
   // "per-thread busy time": 4 ahead left the second thread's drift 50 % slower than the first's). Only the
-  // threads after the first prefetch: the first thread's particles are read by no other thread's pass.
+  // threads after the first prefetch: the first thread's particles are read by no other thread's pass, and its
+  // streams are sequential.
   static constexpr int kPrefetchAhead = 32;
   // How far ahead (adjacency entries) the kick prefetches the result lines it will gather: ~16 particles of
   // the dense packing's ~8.7 listed pairs each, ~200 ns of the kick's work (35 entries left the second
   // thread, which gathers the results the first wrote across the boundary, 20 % slower). Only lines an
-  // earlier thread's pass wrote: with one thread, prefetching every entry cost 2-7 % of a step.
+  // earlier thread's pass wrote, or all from kPrefetchAllFrom particles: with one thread at 4000 spheres,
+  // prefetching every entry cost 2-7 % of a step.
   static constexpr int kPrefetchEntries = 140;
  public:
   // Where thread t of nt starts in a loop of `count` iterations under schedule(static): contiguous runs, the
