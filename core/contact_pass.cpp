@@ -102,6 +102,10 @@ void Simulation::contactPassBlocked() {
   // 2. the law, vectorised across the block (kernels::hertzMindlinBlock); 3. scatter the results and
   // history back and sum the chunk's partials in pair order.
   static_assert(kChunk % kernels::kBlockPairs == 0, "reduction chunks hold whole blocks");
+  static_assert(kernels::kBlockPairs == 64, "a block's touching pairs are one word of ContactStore::touched");
+  if (!m_touchedCurrent) m_c.markTouched();  // after a rebuild, a restore or the other law's pass
+  m_touchedCurrent = true;
+  std::uint64_t* touched = m_c.touched.data();
   const PassArrays arr(m_pass, m_p, m_c, m_cell, m_dt);
   const std::size_t np = arr.np, nchunks = arr.chunks(kChunk);
   const PassParticle* pass = arr.pp;
@@ -110,8 +114,7 @@ void Simulation::contactPassBlocked() {
 #pragma omp parallel num_threads(m_num.threads)
   {
     kernels::PairBlock b{};  // per thread, ~23 KiB: stays in L1 through the three phases
-    std::int32_t index[kernels::kBlockPairs];       // pair of each slot
-    std::int32_t staleIndex[kernels::kBlockPairs];  // pairs whose contact opened this step
+    std::int32_t index[kernels::kBlockPairs];  // pair of each slot
     // one material (the paper's scenes): every pair has the same parameters, written into all the block's
     // slots once per pass (the friction may have changed since the last), not gathered per pair
     const bool oneMaterial = table.materialCount() == 1;
@@ -148,9 +151,10 @@ void Simulation::contactPassBlocked() {
             }
           }
         // 1a. geometry of every listed pair: each is written to slot m, which advances only for a touching
-        // pair; a pair whose contact opened goes to the stale list. No branch depends on the data (40 % of
-        // the listed pairs do not touch: a branch on it was mispredicted about as often).
-        int m = 0, stale = 0;
+        // pair, and marked in the block's word of touching pairs. No branch depends on the data (40 % of the
+        // listed pairs do not touch: a branch on it was mispredicted about as often).
+        int m = 0;
+        std::uint64_t touchingNow = 0;
         for (std::size_t p = p0; p < p1; ++p) {
           const int i = arr.first[p], j = arr.second[p];
           const Vec3 d = arr.branch(p, i, j);
@@ -158,10 +162,7 @@ void Simulation::contactPassBlocked() {
           const double R = ri + rj;
           const double dist2 = d.squaredNorm();
           const int touching = dist2 < R * R;
-          // a touching pair always has a > 0 in its history, and its results are only ever non-zero with
-          // it (a rebuild zeroes the results but carries the history), so the history alone tells
-          staleIndex[stale] = static_cast<std::int32_t>(p);
-          stale += static_cast<int>(arr.hist[p].contactRadius != 0.0) & (touching ^ 1);
+          touchingNow |= static_cast<std::uint64_t>(touching) << (p - p0);
           index[m] = static_cast<std::int32_t>(p);
           b.dx[m] = d.x(), b.dy[m] = d.y(), b.dz[m] = d.z();
           b.dist2[m] = dist2;
@@ -189,11 +190,16 @@ void Simulation::contactPassBlocked() {
           b.tx[s] = h.tangentialForce.x(), b.ty[s] = h.tangentialForce.y(), b.tz[s] = h.tangentialForce.z();
           b.aPrev[s] = h.contactRadius;
         }
-        // the contacts that opened: results and history are zero (the kick gathers the zero force as is)
-        for (int s = 0; s < stale; ++s) {
-          arr.result[staleIndex[s]] = PairResult{};
-          arr.hist[staleIndex[s]] = ContactHistory{};
+        // the contacts that opened (they touched at the last pass: a > 0 in their history, and their results
+        // are only ever non-zero with it; a rebuild zeroes the results but carries the history): results and
+        // history are zero (the kick gathers the zero force as is)
+        std::uint64_t& touchedWord = touched[p0 / kernels::kBlockPairs];
+        for (std::uint64_t opened = touchedWord & ~touchingNow; opened != 0; opened &= opened - 1) {
+          const std::size_t p = p0 + static_cast<std::size_t>(__builtin_ctzll(opened));
+          arr.result[p] = PairResult{};
+          arr.hist[p] = ContactHistory{};
         }
+        touchedWord = touchingNow;
         b.count = m;
         // 2. the law across the block
         kernels::hertzMindlinBlock<kDamping, kEnergy>(b, arr.dt);
@@ -223,6 +229,7 @@ void Simulation::contactPassBlocked() {
 
 template <bool kEnergy, bool kDamping, bool kAffine>
 void Simulation::contactPassMindlinDeresiewicz() {
+  m_touchedCurrent = false;  // this pass changes the history without ContactStore::touched
   const PassArrays arr(m_pass, m_p, m_c, m_cell, m_dt);
   const std::size_t np = arr.np, nchunks = arr.chunks(kChunk);
   const PassParticle* pass = arr.pp;

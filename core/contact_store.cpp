@@ -12,6 +12,12 @@ void ContactStore::resizeResults() {
   result.assign(size(), PairResult{});
 }
 
+void ContactStore::markTouched() {
+  touched.assign((size() + 63) / 64, 0);
+  for (std::size_t p = 0; p < size(); ++p)
+    if (history[p].contactRadius != 0.0) touched[p / 64] |= std::uint64_t{1} << (p % 64);
+}
+
 void ContactStore::buildAdjacency(std::size_t particleCount) {
   adjStart.assign(particleCount + 1, 0);
   for (std::size_t p = 0; p < size(); ++p) {
