@@ -2,7 +2,8 @@
 # Interleaved A/B of two bench_dense builds on the cached 4000-sphere packing (docs/performance.md, "Commands").
 # On a shared VM one binary's rate moves by up to 2x between runs minutes apart, so the two builds are run in
 # alternation, ROUNDS times each, and the script prints the median and the best rate of each per thread count.
-# Noise from other tenants only ever slows a run, so the best of many short runs is the steadiest estimate.
+# Noise from other tenants only ever slows a run, so the best of many short runs is the steadiest estimate;
+# the upper quartile is printed beside it.
 # It also says whether the two builds computed the same bits (bench_dense's state fingerprint; older builds
 # without one print "none").
 #
@@ -48,14 +49,16 @@ if [[ -n ${fpA:-} && $fpA == "${fpB:-}" ]]; then
 else
   echo "same bits: NO (state fingerprint A ${fpA:-none}, B ${fpB:-none})"
 fi
-printf '%-3s %-8s %12s %12s\n' run threads median best
+# the upper quartile too: between the best (one lucky run) and the median (half the runs slowed by the host)
+printf '%-3s %-8s %12s %12s %12s\n' run threads median 'upper q.' best
 sort -k1,1 -k2,2n -k3,3g "$log" | awk '
   { key = $1 " " $2; v[key, ++n[key]] = $3; if (!(key in seen)) { seen[key] = 1; keys[++nk] = key } }
   END {
     for (k = 1; k <= nk; ++k) {
       key = keys[k]; c = n[key]
       med = (c % 2) ? v[key, (c + 1) / 2] : 0.5 * (v[key, c / 2] + v[key, c / 2 + 1])
+      q = v[key, c - int(c / 4)]
       split(key, f, " ")
-      printf "%-3s %-8s %12.4e %12.4e\n", f[1], f[2], med, v[key, c]
+      printf "%-3s %-8s %12.4e %12.4e %12.4e\n", f[1], f[2], med, q, v[key, c]
     }
   }'
