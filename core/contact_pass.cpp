@@ -181,7 +181,7 @@ void Simulation::contactPassBlocked() {
           b.vx[s] = vr.x(), b.vy[s] = vr.y(), b.vz[s] = vr.z();
           b.wix[s] = arr.w[i].x(), b.wiy[s] = arr.w[i].y(), b.wiz[s] = arr.w[i].z();
           b.wjx[s] = arr.w[j].x(), b.wjy[s] = arr.w[j].y(), b.wjz[s] = arr.w[j].z();
-          b.invMassSum[s] = pass[i].invMass + pass[j].invMass;
+          if constexpr (kDamping) b.invMassSum[s] = pass[i].invMass + pass[j].invMass;  // m* of the damping
           if (!oneMaterial) {
             const PairParams& pp = table(arr.mat[i], arr.mat[j]);
             b.effYoung[s] = pp.effYoung, b.effShear[s] = pp.effShear;

@@ -16,6 +16,9 @@ namespace fl {
 namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+// the sign of a pair's force on its first (side 0) and second (side 1) particle: a load, where computing it from
+// the side bit took four operations of the kick's ~20 an entry
+constexpr double kSideSign[2] = {-1.0, 1.0};
 // -1, 0 or +1: the direction Cundall's local damping opposes (drift and kick)
 inline double signOf(double x) { return x > 0 ? 1.0 : (x < 0 ? -1.0 : 0.0); }
 }  // namespace
@@ -299,7 +302,7 @@ void Simulation::kickPass() {
         ty -= arm * c.moment.y();
         tz -= arm * c.moment.z();
         // side 1 (second particle) receives +f, side 0 receives -f
-        const double sign = static_cast<double>(((entry & 1) << 1) - 1);
+        const double sign = kSideSign[entry & 1];
         fx += sign * cfx;
         fy += sign * cfy;
         fz += sign * cfz;
