@@ -28,8 +28,9 @@ export OMP_WAIT_POLICY=passive
 
 configure() {  # dir, extra cmake args...
   local dir="$1"; shift
+  # Unity builds (4 files per unit): the ASan build took 308 s instead of 420 s on 2 cores (2026-12-01).
   cmake -S "$root" -B "$dir" -DFL_BUILD_GUI=OFF -DFL_BUILD_BENCH=OFF -DFL_BUILD_TESTS=ON \
-    -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g -DNDEBUG" "$@" >"$dir.configure.log" 2>&1 || { tail -30 "$dir.configure.log"; exit 1; }
+    -DCMAKE_UNITY_BUILD=ON -DCMAKE_UNITY_BUILD_BATCH_SIZE=4 -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g -DNDEBUG" "$@" >"$dir.configure.log" 2>&1 || { tail -30 "$dir.configure.log"; exit 1; }
 }
 
 # ---- 1. ASan + UBSan: every engine test and the crash-safety test ----------------------------------------
@@ -42,17 +43,23 @@ if [[ "$skip" != *" asan "* ]]; then
   b=$((SECONDS - t)); t=$SECONDS
   # The longest physics runs repeat code paths that the tests kept here already take under ASan; each costs
   # one to five minutes under ASan (Eigen's small-vector code is not inlined there), so they run only in
-  # the normal build: the regression and accuracy runs, the extreme cases, the servo's long holds (the runner
-  # stages keep the servo modes), the reduced paper preparation, the triaxial and drained cyclic stages, the
-  # isotropic / K0-to-p' stages (K0 loading-unloading stays) and a stage started from another run's
-  # checkpoint (RestartMidCycle keeps the checkpoint reader), and the M-D 1-vs-2-thread check (Determinism
-  # keeps the 2-thread pass). Kept: every unit, closed-form and reader test, restart, cyclic undrained,
-  # K0 loading-unloading, VTK output, guards, stability (10:1 grid), and crash safety with 10 kills.
+  # the normal build: the regression and accuracy runs, the extreme cases, the
+  # servo's long holds (the runner stages keep the servo modes), the reduced paper preparation, the triaxial
+  # and drained cyclic stages, the isotropic / K0-to-p' stages (K0 loading-unloading stays), a stage started
+  # from another run's checkpoint and the mid-cycle restart (the crash test restarts runs from checkpoints,
+  # Restart.SaveReload keeps the state reader, and the fuzz pass reads checkpoints under ASan), the M-D
+  # scene and save/reload runs (the M-D kernel and impact tests stay), the quasi-static guard's long run, the
+  # snapshot schedule's run, and the thread-count determinism runs (TSan runs them below; the normal build
+  # checks their bits). Measured 2026-12-01 on 2 cores: these 8 took 550 s of the 1080 s of test time.
+  # Kept: every unit, closed-form and reader test, restart, cyclic undrained, K0 loading-unloading, guards
+  # (time step, blow-up), stability (10:1 grid), and crash safety with 5 kills.
   asan_skip="Regression\.|StabilitySuite\.ExtremeCases|RunnerStages\.CyclicDrained|AccuracyStudy\."
   asan_skip+="|ShippedScenes\.ReducedPaperSpecimen|RunnerStages\.DrainedAndUndrainedTriaxial|Servo\.ConstantVolumeHolds"
   asan_skip+="|Servo\.K0Keeps|Servo\.ReachesAnIsotropic|RunnerStages\.IsotropicCompression|RunnerStages\.K0LoadingToAMean"
   asan_skip+="|RunnerSpecimen\.AStageCanStart|MindlinDeresiewiczSimulation\.OneAndTwoThreads"
-  (cd "$asan" && FL_CRASH_KILLS=10 ctest --output-on-failure -j "$jobs" --timeout 900 -E "$asan_skip" >"$asan/ctest.log" 2>&1) \
+  asan_skip+="|MindlinDeresiewiczSimulation\.SaveReload|MindlinDeresiewiczScene\.|RunnerCheckpoint\.RestartMidCycle"
+  asan_skip+="|Guards\.LeavingTheQuasiStatic|RunnerOutputs\.ParaViewSnapshots|Determinism\."
+  (cd "$asan" && FL_CRASH_KILLS=5 ctest --output-on-failure -j "$jobs" --timeout 900 -E "$asan_skip" >"$asan/ctest.log" 2>&1) \
     || { grep -E "tests passed|Failed|\*\*\*|ERROR|runtime error" "$asan/ctest.log" | head -40; exit 1; }
   step "asan+ubsan build" "$b" "ok"
   step "asan+ubsan ctest (engine + crash)" $((SECONDS - t)) "$(grep -E 'tests passed' "$asan/ctest.log")"
@@ -67,15 +74,16 @@ if [[ "$skip" != *" tsan "* ]]; then
     mkdir -p "$tsan"
     # GUI on: scripts/ci-gui-tsan.sh builds its worker test in this same folder (the core is compiled once)
     CC=clang CXX=clang++ configure "$tsan" -DFL_SANITIZE=thread -DFL_BUILD_GUI=ON  # clang: -fopenmp = LLVM libomp
-    cmake --build "$tsan" -j "$jobs" --target core_tests >"$tsan/build.log" 2>&1 \
+    cmake --build "$tsan" -j "$jobs" --target thread_tests >"$tsan/build.log" 2>&1 \
       || { tail -40 "$tsan/build.log"; exit 1; }
     b=$((SECONDS - t)); t=$SECONDS
     # The tests that run OpenMP regions with more than one thread (parallel contact pass, gather, neighbour
-    # grid) plus restart; 2 threads on this 2-core machine.
-    filter="Determinism.*:NeighbourSearch.*:Restart.*:Conservation.LinearMomentumToRoundOff:RunnerCheckpoint.*"
+    # grid, 3 and 4 threads' uneven chunks) plus restart; 2 threads on this 2-core machine. (The runner's
+    # mid-cycle restart, 64 s under TSan, left in 2026-12-01: the runner adds no parallel region of its own.)
+    filter="Determinism.*:NeighbourSearch.*:Restart.*:Conservation.LinearMomentumToRoundOff"
     OMP_NUM_THREADS=2 OMP_TOOL_LIBRARIES="$archer" ARCHER_OPTIONS="verbose=0" \
       TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$root/tests/tsan.supp" \
-      "$tsan/tests/core_tests" --gtest_filter="$filter" >"$tsan/tsan.log" 2>&1 \
+      "$tsan/tests/thread_tests" --gtest_filter="$filter" >"$tsan/tsan.log" 2>&1 \
       || { grep -E "WARNING: ThreadSanitizer|FAILED|#[0-9]+ " "$tsan/tsan.log" | head -40; exit 1; }
     step "tsan build (clang, libomp)" "$b" "ok"
     step "tsan run (OpenMP core, 2 threads)" $((SECONDS - t)) "$(grep -E '^\[  PASSED' "$tsan/tsan.log")"
