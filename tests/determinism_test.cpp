@@ -3,8 +3,6 @@
 
 #include <cstring>
 
-#include "core/gas_generator.hpp"
-#include "core/rng.hpp"
 #include "core/simulation.hpp"
 #include "test_support.hpp"
 
@@ -12,13 +10,7 @@ using namespace fl;
 
 namespace {
 Simulation compressed(int threads, double localDamping = 0.05, double restitution = 0.5, bool trackEnergy = true) {
-  GasSpec g;
-  g.count = 1500;
-  g.solidFraction = 0.35;
-  g.seed = 11;
-  Packing pk = generateGas(g);
-  Rng rng(3);
-  for (auto& v : pk.particles.vel) v = Vec3(rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1));
+  Packing pk = test::stirredGas(1500, 0.35, 11, 3);
   NumericsSettings num;
   num.threads = threads;
   num.restitution = restitution;

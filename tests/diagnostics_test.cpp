@@ -8,8 +8,6 @@
 #include <cstring>
 
 #include "core/binary_io.hpp"
-#include "core/gas_generator.hpp"
-#include "core/rng.hpp"
 #include "core/simulation.hpp"
 #include "test_support.hpp"
 
@@ -59,13 +57,7 @@ TEST(Diagnostics, PressedPairAgainstClosedForms) {
 }
 
 Simulation compressedGas() {
-  GasSpec g;
-  g.count = 800;
-  g.solidFraction = 0.4;
-  g.seed = 5;
-  Packing pk = generateGas(g);
-  Rng rng(9);
-  for (auto& v : pk.particles.vel) v = Vec3(rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1));
+  Packing pk = test::stirredGas(800, 0.4, 5, 9);
   NumericsSettings num;
   num.restitution = 0.7;
   Simulation sim(std::move(pk.particles), pk.cell, {Material::paperGlass()}, num);

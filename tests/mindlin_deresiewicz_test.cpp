@@ -16,10 +16,8 @@
 #include "core/binary_io.hpp"
 #include "core/contact_kernels.hpp"
 #include "core/errors.hpp"
-#include "core/gas_generator.hpp"
 #include "core/measurements.hpp"
 #include "core/mindlin_deresiewicz.hpp"
-#include "core/rng.hpp"
 #include "core/runner.hpp"
 #include "core/scene.hpp"
 #include "test_support.hpp"
@@ -415,13 +413,7 @@ TEST(MindlinDeresiewiczScene, SelectedByNameRunsAndRejectsUnknownNames) {
 
 namespace {
 Simulation compressedGas(int count, TangentialModel model, int threads, double restitution) {
-  GasSpec g;
-  g.count = count;
-  g.solidFraction = 0.35;
-  g.seed = 11;
-  Packing pk = generateGas(g);
-  Rng rng(3);
-  for (auto& v : pk.particles.vel) v = Vec3(rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1));
+  Packing pk = test::stirredGas(count, 0.35, 11, 3);
   NumericsSettings num;
   num.threads = threads;
   num.restitution = restitution;

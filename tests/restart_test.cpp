@@ -5,20 +5,13 @@
 #include <cstring>
 
 #include "core/binary_io.hpp"
-#include "core/gas_generator.hpp"
-#include "core/rng.hpp"
 #include "core/simulation.hpp"
 #include "test_support.hpp"
 
 using namespace fl;
 
 TEST(Restart, SaveReloadRunIsBitIdenticalToAnUnbrokenRun) {
-  GasSpec g;
-  g.count = 800;
-  g.solidFraction = 0.35;
-  Packing pk = generateGas(g);
-  Rng rng(5);
-  for (auto& v : pk.particles.vel) v = Vec3(rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1));
+  Packing pk = test::stirredGas(800, 0.35, 1, 5);
   NumericsSettings num;
   num.restitution = 0.6;
   num.localDamping = 0.05;

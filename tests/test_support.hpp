@@ -4,9 +4,24 @@
 #include <cstring>
 #include <vector>
 
+#include "core/gas_generator.hpp"
+#include "core/rng.hpp"
 #include "core/simulation.hpp"
 
 namespace fl::test {
+
+// A random gas of paper glass beads (generateGas) with each velocity component uniform in ±0.1 m/s: the
+// start of the many-contact runs (determinism, restart, diagnostics, Mindlin–Deresiewicz).
+inline Packing stirredGas(int count, double solidFraction, std::uint64_t gasSeed, std::uint64_t velocitySeed) {
+  GasSpec g;
+  g.count = count;
+  g.solidFraction = solidFraction;
+  g.seed = gasSeed;
+  Packing pk = generateGas(g);
+  Rng rng(velocitySeed);
+  for (auto& v : pk.particles.vel) v = Vec3(rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1));
+  return pk;
+}
 
 // Two spheres in a large periodic box (so they meet only each other), moving at v1, v2.
 inline Simulation twoSpheres(double r1, double r2, const Vec3& x1, const Vec3& x2, const Vec3& v1,
