@@ -103,8 +103,7 @@ void Simulation::contactPassBlocked() {
   // history back and sum the chunk's partials in pair order.
   static_assert(kChunk % kernels::kBlockPairs == 0, "reduction chunks hold whole blocks");
   static_assert(kernels::kBlockPairs == 64, "a block's touching pairs are one word of ContactStore::touched");
-  if (!m_touchedCurrent) m_c.markTouched();  // after a rebuild, a restore or the other law's pass
-  m_touchedCurrent = true;
+  if (!m_c.touchedValid) m_c.markTouched();  // after a rebuild, a restore or the other law's pass
   std::uint64_t* touched = m_c.touched.data();
   const PassArrays arr(m_pass, m_p, m_c, m_cell, m_dt);
   const std::size_t np = arr.np, nchunks = arr.chunks(kChunk);
@@ -229,7 +228,7 @@ void Simulation::contactPassBlocked() {
 
 template <bool kEnergy, bool kDamping, bool kAffine>
 void Simulation::contactPassMindlinDeresiewicz() {
-  m_touchedCurrent = false;  // this pass changes the history without ContactStore::touched
+  m_c.touchedValid = false;  // this pass changes the history without ContactStore::touched
   const PassArrays arr(m_pass, m_p, m_c, m_cell, m_dt);
   const std::size_t np = arr.np, nchunks = arr.chunks(kChunk);
   const PassParticle* pass = arr.pp;

@@ -16,6 +16,7 @@ void ContactStore::markTouched() {
   touched.assign((size() + 63) / 64, 0);
   for (std::size_t p = 0; p < size(); ++p)
     if (history[p].contactRadius != 0.0) touched[p / 64] |= std::uint64_t{1} << (p % 64);
+  touchedValid = true;
 }
 
 void ContactStore::buildAdjacency(std::size_t particleCount) {

@@ -71,8 +71,10 @@ struct ContactStore {
   std::vector<PairResult> result;
   // bit p % 64 of word p / 64 is set when pair p holds a contact, i.e. its history has a > 0: the default law's
   // pass finds the contacts that opened from these words instead of reading every listed pair's history.
-  // Mirrors the history at the start of that pass (markTouched after anything else changed the history).
+  // Mirrors the history while touchedValid (markTouched sets both; the other law's pass clears the flag; a new
+  // or restored store starts without).
   std::vector<std::uint64_t> touched;
+  bool touchedValid = false;
   // adjacency: pairs of particle k are adjEntry[adjStart[k] .. adjStart[k+1]) as (pair << 1 | side),
   // side 0 when k is the pair's first particle, 1 when second.
   std::vector<std::int32_t> adjStart, adjEntry;

@@ -56,6 +56,13 @@ void checkInvariants(const Simulation& sim) {
     if (ft.norm() > mu * q.normalForce * (1 + 1e-9) + 1e-300)
       violated("pair " + std::to_string(k) + " tangential force above the Coulomb limit");
   }
+  // the default law's words of touching pairs mirror the history (a > 0) while they are marked valid
+  if (c.touchedValid) {
+    if (c.touched.size() != (c.size() + 63) / 64) violated("words of touching pairs: wrong length");
+    for (std::size_t k = 0; k < c.size(); ++k)
+      if (((c.touched[k / 64] >> (k % 64)) & 1) != (c.history[k].contactRadius != 0.0 ? 1u : 0u))
+        violated("pair " + std::to_string(k) + " touching bit differs from its history");
+  }
   if (c.adjStart.size() != n + 1 || c.adjEntry.size() != 2 * c.size()) violated("adjacency sizes");
   for (std::size_t i = 0; i < n; ++i) {
     if (c.adjStart[i + 1] - c.adjStart[i] != seen[i]) violated("adjacency of particle " + std::to_string(i));

@@ -227,7 +227,6 @@ void Simulation::rebuildNeighbours() {
   next.resizeResults();
   next.buildAdjacency(n);
   m_c = std::move(next);
-  m_touchedCurrent = false;
   m_refPos = m_p.pos;
   m_refHinv = m_cell.inverse();
   m_maxDisp2 = 0.0;

@@ -191,7 +191,6 @@ class Simulation {
   mutable ContactDiagnostics m_diag;
   mutable double m_elasticNormal = 0.0, m_elasticTangential = 0.0;  // [J], of the last pass
   mutable bool m_contactsMeasured = false;  // m_diag and the elastic energies are of the last pass
-  bool m_touchedCurrent = false;  // ContactStore::touched mirrors the history (contactPassBlocked)
   StageProfile m_profile;
   // Fixed reduction block (pairs or particles): results are independent of the thread count. Small enough
   // that 2 threads share ~60 blocks of a 4000-sphere packing evenly, large enough to amortise a block's sums.

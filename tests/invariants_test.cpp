@@ -32,6 +32,7 @@ TEST(Invariants, HoldOnACompressedFrictionalPackingAndCatchCorruption) {
     EXPECT_NO_THROW(checkInvariants(sim));
   }
   ASSERT_GT(sim.contacts().activeCount(), 100u);
+  ASSERT_TRUE(sim.contacts().touchedValid) << "the default law's pass keeps its words of touching pairs";
   Simulation broken = std::move(sim);
   broken.mutableParticles().vel[7].x() = std::nan("");
   EXPECT_THROW(checkInvariants(broken), Error);
