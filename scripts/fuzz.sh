@@ -9,7 +9,8 @@
 # contract (an exception other than fl::InputError/IoError, a message without the file name, ...);
 # the reproducer is kept in $FL_FUZZ_BUILD/artifacts/ (replay: <target> <file>).
 # Usage: scripts/fuzz.sh [seconds-per-target]    (default 60; env FL_FUZZ_BUILD, default /tmp/rel-fuzz;
-#        FL_FUZZ_TARGETS to pick targets, e.g. "fuzz_lammps fuzz_checkpoint")
+#        FL_FUZZ_TARGETS to pick targets, e.g. "fuzz_lammps fuzz_checkpoint"; FL_FUZZ_PREBUILT=1: the targets
+#        are already built in FL_FUZZ_BUILD, e.g. build-asan/tests/fuzz of CI's ASan build with FL_FUZZ=ON)
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 secs="${1:-60}"
@@ -17,10 +18,16 @@ build="${FL_FUZZ_BUILD:-/tmp/rel-fuzz}"
 targets=(${FL_FUZZ_TARGETS:-fuzz_scene_json fuzz_scene_file fuzz_packing_csv fuzz_lammps fuzz_checkpoint})
 
 command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ not found (apt-get install clang libclang-rt-14-dev libomp-14-dev)"; exit 1; }
-if [ ! -f "$build/CMakeCache.txt" ]; then
-  CXX=clang++ cmake -S "$root/tests/fuzz" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+if [ -n "${FL_FUZZ_PREBUILT:-}" ]; then
+  for t in "${targets[@]}" fuzz_make_seeds; do
+    [ -x "$build/$t" ] || { echo "fuzz.sh: FL_FUZZ_PREBUILT is set but $build/$t is not built"; exit 1; }
+  done
+else
+  if [ ! -f "$build/CMakeCache.txt" ]; then
+    CXX=clang++ cmake -S "$root/tests/fuzz" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+  fi
+  cmake --build "$build" -j "${FL_JOBS:-2}" >"$build/build.log" 2>&1 || { tail -40 "$build/build.log"; exit 1; }
 fi
-cmake --build "$build" -j "${FL_JOBS:-2}" >"$build/build.log" 2>&1 || { tail -40 "$build/build.log"; exit 1; }
 
 # Seed corpus: shipped scenes (JSON with comments), generated checkpoint / CSV / LAMMPS files.
 seeds="$build/seeds"
@@ -47,8 +54,9 @@ for t in "${targets[@]}"; do
   [ -n "${dict[$t]:-}" ] && args+=(-dict="$root/tests/fuzz/${dict[$t]}")
   log="$build/$t.log"
   result=ok
-  # UBSan findings abort (built with -fno-sanitize-recover); LeakSanitizer on.
-  UBSAN_OPTIONS=print_stacktrace=1 ASAN_OPTIONS=detect_leaks=1 OMP_NUM_THREADS=1 \
+  # UBSan findings abort (the standalone build has no recovery; CI's ASan build's core recovers unless told to
+  # halt); LeakSanitizer on.
+  UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ASAN_OPTIONS=detect_leaks=1 OMP_NUM_THREADS=1 \
     "$build/$t" "${args[@]}" "$corpus" "$seeds/${seed[$t]}" >"$log" 2>&1 || { result=FAILED; status=1; }
   execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
   units=$(ls "$corpus" | wc -l)
