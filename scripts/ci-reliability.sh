@@ -9,7 +9,8 @@
 # The ASan build uses clang -O2 (g++ -O1 took 573 s to build and 880 s to test here; clang -O2 190 s and
 # ~360 s with the skip list below); the TSan build uses clang -O1.
 # Prints the time of each step. Env: FL_ASAN_BUILD_DIR (default build-asan), FL_TSAN_BUILD_DIR (build-tsan),
-# FL_FUZZ_BUILD (build-fuzz; only when asan is skipped, else the ASan folder's tests/fuzz), FL_JOBS (2), FL_RELIABILITY_SKIP (space-separated: asan tsan fuzz gui-tsan).
+# FL_FUZZ_BUILD (build-fuzz; only when asan is skipped, else the ASan folder's tests/fuzz), FL_JOBS (2),
+# FL_RELIABILITY_SKIP (space-separated: asan tsan fuzz gui-tsan).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 jobs="${FL_JOBS:-2}"
