@@ -16,9 +16,6 @@ namespace fl {
 namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-// the sign of a pair's force on its first (side 0) and second (side 1) particle: a load, where computing it from
-// the side bit took four operations of the kick's ~20 an entry
-constexpr double kSideSign[2] = {-1.0, 1.0};
 // -1, 0 or +1: the direction Cundall's local damping opposes (drift and kick)
 inline double signOf(double x) { return x > 0 ? 1.0 : (x < 0 ? -1.0 : 0.0); }
 }  // namespace
@@ -136,7 +133,6 @@ void Simulation::drift() {
     m_energy.boundaryWork -= Vm * (m_stress.cwiseProduct(L)).sum() * dt;
   }
   const Mat3 Fref = m_cell.matrix() * m_refHinv;
-  const int n = static_cast<int>(m_p.size());
   const double alpha = m_num.localDamping;
   Vec3* x = m_p.pos.data();
   Vec3* v = m_p.vel.data();
@@ -148,12 +144,14 @@ void Simulation::drift() {
   const Vec3* x0 = m_refPos.data();
   PassParticle* pass = m_pass.data();
   double maxd2 = 0.0;
+  const ThreadBoundary& tb = threadBoundary();
 #pragma omp parallel num_threads(m_num.threads) reduction(max : maxd2)
   {
-  const bool prefetch = omp_get_thread_num() > 0;  // see kPrefetchAhead
-#pragma omp for schedule(static)
-  for (int i = 0; i < n; ++i) {
-    if (prefetch && i + kPrefetchAhead < n) {
+  const int thread = omp_get_thread_num();
+  const bool prefetch = thread > 0;  // see kPrefetchAhead
+  const auto [begin, end] = particleShare(tb, thread, omp_get_num_threads());
+  for (int i = begin; i < end; ++i) {
+    if (prefetch && i + kPrefetchAhead < end) {
       __builtin_prefetch(x + i + kPrefetchAhead, 1);
       __builtin_prefetch(v + i + kPrefetchAhead, 1);
       __builtin_prefetch(w + i + kPrefetchAhead, 1);
@@ -242,16 +240,37 @@ void Simulation::packPassParticles() {
 
 void Simulation::resizeChunks() {
   m_chunks.resize(std::max<std::size_t>(1, (std::max(m_c.size(), m_p.size()) + kChunk - 1) / kChunk));
+  m_boundary = ThreadBoundary{};  // the pairs changed: built again at its first use
+  m_seedsReady = false;
+}
+
+const ThreadBoundary& Simulation::threadBoundary() {
+  if (m_boundary.threads != m_num.threads) {
+    m_boundary = buildThreadBoundary(m_c, m_p.size(), m_num.threads, kChunk);
+    m_haloPass.resize(m_boundary.halo.size());
+    m_haloW.resize(m_boundary.halo.size());
+    m_seeds.assign(m_boundary.seedParticle.size(), KickSeed{});
+    m_seedsReady = false;
+  }
+  return m_boundary;
+}
+
+std::pair<int, int> Simulation::particleShare(const ThreadBoundary& tb, int t, int nt) const {
+  if (nt == tb.threads) return {static_cast<int>(tb.begin[t]), static_cast<int>(tb.begin[t + 1])};
+  return {static_cast<int>(staticBegin(t, nt, m_p.size())), static_cast<int>(staticBegin(t + 1, nt, m_p.size()))};
 }
 
 // ---- 3. contacts: core/contact_pass.cpp ---------------------------------------------------------
 
 // ---- 4. kick ------------------------------------------------------------------------------------
 void Simulation::kick() {
-  m_num.localDamping > 0.0 ? kickPass<true>() : kickPass<false>();
+  // seeds only after a pass that summed them (thread_boundary.hpp); one thread never has any
+  const bool seeds = m_seedsReady;
+  if (m_num.localDamping > 0.0) seeds ? kickPass<true, true>() : kickPass<true, false>();
+  else seeds ? kickPass<false, true>() : kickPass<false, false>();
 }
 
-template <bool kLocalDamping>
+template <bool kLocalDamping, bool kSeeded>
 void Simulation::kickPass() {
   const int n = static_cast<int>(m_p.size());
   const std::size_t nchunks = (static_cast<std::size_t>(n) + kChunk - 1) / kChunk;
@@ -268,59 +287,74 @@ void Simulation::kickPass() {
   Vec3* w = m_p.angVel.data();
   const double* im = m_p.invMass.data();
   const double* ii = m_p.invInertia.data();
-  const std::size_t passChunks = (m_c.size() + kChunk - 1) / kChunk;
+  if constexpr (kLocalDamping) m_kickWork.resize(3 * static_cast<std::size_t>(n));
+  double* kickWork = m_kickWork.data();
+  const ThreadBoundary& tb = threadBoundary();
+  const KickSeed* seeds = m_seeds.data();
+  const bool seedsReady = m_seedsReady;
+  m_seedsReady = false;
 #pragma omp parallel num_threads(m_num.threads)
   {
-  // result lines of pairs below this entry were written by an earlier thread's pass, or all are out of
-  // cache (see kPrefetchEntries)
-  const auto remoteBelow = static_cast<std::int32_t>(
-      static_cast<std::size_t>(n) >= kPrefetchAllFrom
-          ? 2 * m_c.size()
-          : 2 * kChunk * staticBegin(omp_get_thread_num(), omp_get_num_threads(), passChunks));
-#pragma omp for schedule(static)
-  for (std::size_t k = 0; k < nchunks; ++k) {
-    double work = 0.0;
-    const int end = static_cast<int>(std::min<std::size_t>(n, (k + 1) * kChunk));
-    for (int i = static_cast<int>(k * kChunk); i < end; ++i) {
-      // Pairs that do not touch hold a zero force (the contact pass keeps it so), so they are gathered
-      // without a branch: adding zero changes nothing but the sign of a zero. Scalar sums: with Eigen
-      // temporaries g++ spilled a cross product as two 8-byte stores read back as one 16-byte load, a
-      // store-forwarding stall on the loop-carried torque (kick 5x slower).
-      const double ri = rad[i];
-      double fx = 0.0, fy = 0.0, fz = 0.0, tx = 0.0, ty = 0.0, tz = 0.0;
-      for (int e = adjStart[i]; e < adjStart[i + 1]; ++e) {
-        // the result line kPrefetchEntries entries ahead (about 16 particles), if another core wrote it
-        if (remoteBelow > 0 && e + kPrefetchEntries < entries && adjEntry[e + kPrefetchEntries] < remoteBelow)
-          __builtin_prefetch(res + (adjEntry[e + kPrefetchEntries] >> 1));
-        const int entry = adjEntry[e];
-        const PairResult& c = res[entry >> 1];
-        const double cfx = c.force.x(), cfy = c.force.y(), cfz = c.force.z();
-        // torque = -(r_self - delta/2) n x f on both particles (contact point on the pair axis)
-        const double arm = ri - 0.5 * c.overlap;
-        tx -= arm * c.moment.x();
-        ty -= arm * c.moment.y();
-        tz -= arm * c.moment.z();
-        // side 1 (second particle) receives +f, side 0 receives -f
-        const double sign = kSideSign[entry & 1];
-        fx += sign * cfx;
-        fy += sign * cfy;
-        fz += sign * cfz;
-      }
-      Vec3 f(fx, fy, fz), t(tx, ty, tz);
-      F[i] = f;
-      T[i] = t;
-      if constexpr (kLocalDamping) {
-        // Cundall non-viscous damping: each component of the force opposes the velocity by alpha |F|
-        for (int a = 0; a < 3; ++a) {
-          f[a] -= alpha * std::abs(f[a]) * signOf(v[i][a]);
-          t[a] -= alpha * std::abs(t[a]) * signOf(w[i][a]);
-          work += alpha * (std::abs(F[i][a] * v[i][a]) + std::abs(T[i][a] * w[i][a])) * m_dt;
-        }
-      }
-      v[i] += (h * im[i]) * f;
-      w[i] += (h * ii[i]) * t;
+  const int thread = omp_get_thread_num(), threads = omp_get_num_threads();
+  const auto [begin, end] = particleShare(tb, thread, threads);
+  // the seeds of this pass hold the leading entries another thread computed; without them (another team
+  // size, the Mindlin–Deresiewicz pass) every entry is read in place
+  const bool seeded = kSeeded && seedsReady && threads == tb.threads;
+  const std::int32_t* kickBegin = tb.kickBegin.data();
+  const std::int32_t* seedOf = tb.seedOf.data();
+  // result lines to prefetch (kPrefetchEntries): all when the state outgrows the caches, else those of pairs
+  // an earlier thread computed, unless the seeds already carry them
+  const std::size_t passChunks = (m_c.size() + kChunk - 1) / kChunk;
+  const auto ownFrom = static_cast<std::int32_t>(
+      2 * kChunk * (threads == tb.threads ? tb.chunkBegin[thread] : staticBegin(thread, threads, passChunks)));
+  const bool large = static_cast<std::size_t>(n) >= kPrefetchAllFrom;
+  const std::int32_t fetchFrom = large && seeded ? ownFrom : 0;
+  const std::int32_t fetchTo = large ? static_cast<std::int32_t>(2 * m_c.size()) : seeded ? 0 : ownFrom;
+  const bool fetch = fetchTo > fetchFrom;
+  for (int i = begin; i < end; ++i) {
+    // Pairs that do not touch hold a zero force (the contact pass keeps it so), so they are gathered
+    // without a branch: adding zero changes nothing but the sign of a zero. Scalar sums: with Eigen
+    // temporaries g++ spilled a cross product as two 8-byte stores read back as one 16-byte load, a
+    // store-forwarding stall on the loop-carried torque (kick 5x slower).
+    const double ri = rad[i];
+    double fx = 0.0, fy = 0.0, fz = 0.0, tx = 0.0, ty = 0.0, tz = 0.0;
+    if (kSeeded && seeded) {  // slot 0: zero
+      const KickSeed& s0 = seeds[seedOf[i]];
+      fx = s0.fx, fy = s0.fy, fz = s0.fz, tx = s0.tx, ty = s0.ty, tz = s0.tz;
     }
-    m_chunks[k].localDamping = work;
+    for (int e = kSeeded && seeded ? kickBegin[i] : adjStart[i]; e < adjStart[i + 1]; ++e) {
+      // the result line kPrefetchEntries entries ahead (about 16 particles), if it is not in this core's cache
+      if (fetch && e + kPrefetchEntries < entries) {
+        const std::int32_t ahead = adjEntry[e + kPrefetchEntries];
+        if (ahead >= fetchFrom && ahead < fetchTo) __builtin_prefetch(res + (ahead >> 1));
+      }
+      const std::int32_t entry = adjEntry[e];
+      kickEntry(res[entry >> 1], entry, ri, fx, fy, fz, tx, ty, tz);
+    }
+    Vec3 f(fx, fy, fz), t(tx, ty, tz);
+    F[i] = f;
+    T[i] = t;
+    if constexpr (kLocalDamping) {
+      // Cundall non-viscous damping: each component of the force opposes the velocity by alpha |F|
+      for (int a = 0; a < 3; ++a) {
+        f[a] -= alpha * std::abs(f[a]) * signOf(v[i][a]);
+        t[a] -= alpha * std::abs(t[a]) * signOf(w[i][a]);
+        kickWork[3 * i + a] = alpha * (std::abs(F[i][a] * v[i][a]) + std::abs(T[i][a] * w[i][a])) * m_dt;
+      }
+    }
+    v[i] += (h * im[i]) * f;
+    w[i] += (h * ii[i]) * t;
+  }
+  if constexpr (kLocalDamping) {
+    // the work of each fixed chunk of particles, summed in particle order: the same bits for any split
+#pragma omp barrier
+#pragma omp for schedule(static)
+    for (std::size_t k = 0; k < nchunks; ++k) {
+      double work = 0.0;
+      const std::size_t e = 3 * std::min<std::size_t>(n, (k + 1) * kChunk);
+      for (std::size_t q = 3 * k * kChunk; q < e; ++q) work += kickWork[q];
+      m_chunks[k].localDamping = work;
+    }
   }
   }
   if constexpr (kLocalDamping) {
@@ -336,7 +370,9 @@ std::size_t Simulation::memoryBytes() const {
   return b(p.pos) + b(p.vel) + b(p.angVel) + b(p.force) + b(p.torque) + b(p.radius) + b(p.invMass) +
          b(p.invInertia) + b(p.id) + b(p.material) + b(p.image) + b(c.first) + b(c.second) + b(c.image) +
          b(c.history) + b(c.mdHistory) + b(c.result) + b(c.adjStart) + b(c.adjEntry) + b(m_refPos) +
-         b(m_pass) + b(m_chunks);
+         b(m_pass) + b(m_chunks) + b(m_kickWork) + b(m_haloPass) + b(m_haloW) + b(m_seeds) +
+         b(m_boundary.partner) + b(m_boundary.halo) + b(m_boundary.seedParticle) + b(m_boundary.seedOf) +
+         b(m_boundary.kickBegin);
 }
 
 // ---- measures -----------------------------------------------------------------------------------

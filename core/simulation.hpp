@@ -29,6 +29,7 @@
 #include "numerics.hpp"
 #include "particle_store.hpp"
 #include "periodic_cell.hpp"
+#include "thread_boundary.hpp"
 
 namespace fl {
 
@@ -148,8 +149,8 @@ class Simulation {
   template <bool kEnergy, bool kDamping, bool kAffine, bool kMindlinDeresiewicz>
   void contactPass();  // selects one of the two below
   // Default law: pairs gathered into blocks of touching pairs, law vectorised across them (contact_block.hpp).
-  template <bool kEnergy, bool kDamping, bool kAffine>
-  void contactPassBlocked();
+  template <bool kEnergy, bool kDamping, bool kAffine, bool kHalo>
+  void contactPassBlocked();  // kHalo: partners of other threads' shares are read from the halo
   // Mindlin–Deresiewicz law: one pair at a time (its branch history does not vectorise).
   template <bool kEnergy, bool kDamping, bool kAffine>
   void contactPassMindlinDeresiewicz();
@@ -165,8 +166,14 @@ class Simulation {
   // switching to it, fresh histories start from the stored normal forces).
   void syncTangentialHistory();
   void kick();
-  template <bool kLocalDamping>
+  template <bool kLocalDamping, bool kSeeded>
   void kickPass();
+  // The threads' shares and what crosses between them, for m_num.threads (thread_boundary.hpp); built after
+  // each rebuild or restore and when the thread count changes. A parallel region whose team is not that
+  // size splits the particles statically and reads everything in place.
+  const ThreadBoundary& threadBoundary();
+  // thread t's share [first, second) of the particles in a team of nt
+  std::pair<int, int> particleShare(const ThreadBoundary& tb, int t, int nt) const;
 
   ParticleStore m_p;
   std::vector<PassParticle> m_pass;  // the contact pass's copy of x, r, v, 1/m (particle_store.hpp)
@@ -232,6 +239,14 @@ class Simulation {
     char pad[64] = {};  // keep neighbouring chunks on separate cache lines
   };
   std::vector<Chunk> m_chunks;
+  // the kick's local-damping work terms of each particle (3 per particle, in the order the serial sum adds
+  // them), summed per fixed chunk of particles after the kick: the threads' shares need not fall on chunks
+  std::vector<double> m_kickWork;
+  ThreadBoundary m_boundary;
+  std::vector<PassParticle> m_haloPass;  // halo slots: the pass copy and omega of other threads' partners
+  std::vector<Vec3> m_haloW;
+  std::vector<KickSeed> m_seeds;  // slot 0 stays zero
+  bool m_seedsReady = false;      // the last pass summed the seeds for this team
 };
 
 }  // namespace fl

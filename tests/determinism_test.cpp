@@ -58,3 +58,25 @@ TEST(Determinism, WithoutDampingOneToFourThreadsGiveIdenticalBits) {
     expectSameBits(a, b);
   }
 }
+
+// With local and contact damping on, the whole energy ledger (not only the trajectory) has the same bits for
+// 1, 2 and 3 threads: the dissipated works are summed per fixed chunk of pairs or particles, in chunk order,
+// whichever thread computed a chunk (3 threads split the 16 particle chunks and the pair chunks unevenly).
+TEST(Determinism, LocalDampingWorkHasTheSameBitsForOneToThreeThreads) {
+  Simulation a = compressed(1);
+  a.run(3000);
+  ASSERT_GT(a.energy().localDampingWork, 0.0) << "the test must exercise the local damping";
+  for (int threads : {2, 3}) {
+    SCOPED_TRACE(threads);
+    Simulation b = compressed(threads);
+    b.run(3000);
+    expectSameBits(a, b);
+    const EnergyLedger& ea = a.energy();
+    const EnergyLedger& eb = b.energy();
+    EXPECT_EQ(ea.localDampingWork, eb.localDampingWork);
+    EXPECT_EQ(ea.contactDampingWork, eb.contactDampingWork);
+    EXPECT_EQ(ea.frictionWork, eb.frictionWork);
+    EXPECT_EQ(ea.boundaryWork, eb.boundaryWork);
+    EXPECT_EQ(ea.kinetic, eb.kinetic);
+  }
+}
