@@ -220,15 +220,6 @@ class Simulation {
   // earlier thread's pass wrote, or all from kPrefetchAllFrom particles: with one thread at 4000 spheres,
   // prefetching every entry cost 2-7 % of a step.
   static constexpr int kPrefetchEntries = 140;
- public:
-  // Where thread t of nt starts in a loop of `count` iterations under schedule(static): contiguous runs, the
-  // first count % nt one longer (libgomp and libomp alike). Only prefetch decisions use it, never the bits.
-  static std::size_t staticBegin(int t, int nt, std::size_t count) {
-    const std::size_t q = count / static_cast<std::size_t>(nt), r = count % static_cast<std::size_t>(nt);
-    const std::size_t k = static_cast<std::size_t>(t);
-    return k * q + std::min(k, r);
-  }
- private:
   // Partial sums of one fixed block of pairs (or particles), reduced in block order.
   struct Chunk {
     Mat3 stress = Mat3::Zero();  // sum f (x) l [N m]

@@ -5,16 +5,6 @@
 
 namespace fl {
 
-namespace {
-// where share t of nt starts in `count` items under a static schedule (contiguous, the first count % nt one
-// longer), as Simulation::staticBegin
-std::size_t staticStart(int t, int nt, std::size_t count) {
-  const std::size_t q = count / static_cast<std::size_t>(nt), r = count % static_cast<std::size_t>(nt);
-  const std::size_t k = static_cast<std::size_t>(t);
-  return k * q + std::min(k, r);
-}
-}  // namespace
-
 ThreadBoundary buildThreadBoundary(const ContactStore& c, std::size_t particleCount, int threads,
                                    std::size_t chunk) {
   ThreadBoundary b;
@@ -24,11 +14,11 @@ ThreadBoundary buildThreadBoundary(const ContactStore& c, std::size_t particleCo
   b.threads = nt;
   b.begin.resize(nt + 1);
   b.chunkBegin.resize(nt + 1);
-  for (int t = 0; t <= nt; ++t) b.chunkBegin[t] = staticStart(t, nt, chunks);
+  for (int t = 0; t <= nt; ++t) b.chunkBegin[t] = staticBegin(t, nt, chunks);
   const bool exchange = nt > 1 && chunks >= static_cast<std::size_t>(nt);
   for (int t = 0; t <= nt; ++t)
     b.begin[t] = t == nt ? n
-                 : !exchange ? staticStart(t, nt, n)
+                 : !exchange ? staticBegin(t, nt, n)
                  : t == 0 ? 0
                           : static_cast<std::size_t>(c.first[chunk * b.chunkBegin[t]]);
   b.haloBegin.assign(nt + 1, 0);

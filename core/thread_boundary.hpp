@@ -12,7 +12,7 @@
 // Halo slots are copies and seeds are the kick's own partial sums, so the bits do not depend on the split.
 #pragma once
 
-#include <cmath>
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -20,6 +20,14 @@
 #include "contact_store.hpp"
 
 namespace fl {
+
+// Where share t of nt starts in `count` items split statically: contiguous runs, the first count % nt one
+// longer (as schedule(static) in libgomp and libomp). It splits the work, never the bits.
+inline std::size_t staticBegin(int t, int nt, std::size_t count) {
+  const std::size_t q = count / static_cast<std::size_t>(nt), r = count % static_cast<std::size_t>(nt);
+  const std::size_t k = static_cast<std::size_t>(t);
+  return k * q + std::min(k, r);
+}
 
 struct ThreadBoundary {
   int threads = 0;        // 0: not built
