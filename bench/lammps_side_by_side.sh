@@ -26,6 +26,7 @@ steps=20000
 repeats=5
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 . "$root/bench/common.sh"
+. "$root/bench/lammps.sh"
 build="$root/build/perf"
 out="$root/build/bench-cache"
 while [[ $# -gt 0 ]]; do
@@ -42,15 +43,7 @@ done
 die() { echo "lammps_side_by_side: FAIL: $*" >&2; exit 1; }
 
 # ---- 1. LAMMPS --------------------------------------------------------------------------------------
-if ! dpkg -s lammps >/dev/null 2>&1 || ! command -v lmp >/dev/null 2>&1; then
-  sudo=""
-  [[ $(id -u) -ne 0 ]] && sudo="sudo"
-  echo "installing Debian's lammps ..."
-  $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y --no-install-recommends lammps openmpi-bin >/dev/null
-fi
-command -v mpirun >/dev/null || die "mpirun not found (Debian package openmpi-bin)"
-lmp_version="$(dpkg -s lammps | sed -n 's/^Version: //p')"
+lmp_version="$(ensure_lammps)"
 
 # ---- 2.-3. FabricLab ---------------------------------------------------------------------------------
 bench="$build/bench/bench_dense"
@@ -66,38 +59,10 @@ echo "== FabricLab ($bench): the scene, the export and the thread-count check ==
 grep -q '^final positions bit-identical across thread counts: yes' "$work/fabriclab.txt" ||
   die "FabricLab's 1- and 2-thread runs differ"
 export_line="$(grep '^export:' "$work/fabriclab.txt")" || die "bench_dense printed no export line"
-field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" <<<"$export_line"; }
-N="$(field N)"; E="$(field E)"; nu="$(field nu)"; mu="$(field mu)"; skin="$(field skin)"; dt="$(field dt)"
-fl_p0="$(field p0)"; fl_z0="$(field Z0)"
+N="$(export_field "$export_line" N)"; fl_p0="$(export_field "$export_line" p0)"; fl_z0="$(export_field "$export_line" Z0)"
 
 # ---- 4. LAMMPS --------------------------------------------------------------------------------------
-cat >"$work/in.dense" <<EOF
-# FabricLab benchmark scene: Hertz-Mindlin glass beads, no damping, dt = $dt s
-units           si
-atom_style      sphere
-boundary        p p p
-newton          on
-comm_modify     vel yes
-read_data       $data
-neighbor        $skin bin
-neigh_modify    delay 0 every 1 check yes
-# hertz/material E eta_n0 nu: eta_n0 = 0 -> no normal damping; mindlin NULL -> k_t = 8 G* a from E, nu;
-# x_gamma_t = 0 -> no tangential damping; Coulomb mu
-pair_style      granular
-pair_coeff      * * hertz/material $E 0.0 $nu tangential mindlin NULL 0.0 $mu damping viscoelastic
-fix             integrate all nve/sphere
-timestep        $dt
-compute         zc all contact/atom
-compute         zsum all reduce sum c_zc
-compute         pv all pressure NULL virial
-variable        Z equal c_zsum/atoms
-thermo_style    custom step c_pv v_Z
-thermo_modify   format float %.10g
-run             0
-print           "STEP0 p=\$(c_pv:%.12g) Z=\$(v_Z:%.12g)"
-run             $steps
-print           "END p=\$(c_pv:%.12g) Z=\$(v_Z:%.12g)"
-EOF
+write_lammps_input "$work/in.dense" "$data" "$export_line" "$steps"
 
 # ---- 5. the pairs ----------------------------------------------------------------------------------
 fabriclab_rate() {  # threads -> particle-steps/s of one run, thread t on core t like MPI's rank r on core r
@@ -105,21 +70,14 @@ fabriclab_rate() {  # threads -> particle-steps/s of one run, thread t on core t
     { cat "$work/fl$1.txt" >&2; die "FabricLab failed on $1 thread(s)"; }
   sed -n "s/^result: threads=$1 rate=\([^ ]*\).*/\1/p" "$work/fl$1.txt"
 }
-lammps_rate() {  # ranks -> particle-steps/s of one run
-  local ranks="$1" loop
-  mpirun --allow-run-as-root --bind-to core -np "$ranks" lmp -in "$work/in.dense" -log none -screen "$work/lmp$ranks.txt" \
-    >/dev/null 2>&1 || { cat "$work/lmp$ranks.txt" >&2; die "LAMMPS failed on $ranks rank(s)"; }
-  loop="$(awk '/^Loop time of/ {t=$4} END {print t}' "$work/lmp$ranks.txt")"
-  awk -v n="$N" -v s="$steps" -v t="$loop" 'BEGIN {printf "%.6e\n", n * s / t}'
-}
 echo
 echo "== pairs: FabricLab and LAMMPS $lmp_version back to back, $steps steps each =="
 printf "%-7s %-20s %14s %14s %8s\n" "repeat" "threads / ranks" "FabricLab" "LAMMPS" "ratio"
 : >"$work/pairs.txt"
 for ((k = 1; k <= repeats; ++k)); do
   for t in 1 2; do
-    if ((k % 2)); then fl="$(fabriclab_rate "$t")"; lm="$(lammps_rate "$t")"
-    else lm="$(lammps_rate "$t")"; fl="$(fabriclab_rate "$t")"; fi
+    if ((k % 2)); then fl="$(fabriclab_rate "$t")"; lm="$(lammps_rate "$work/in.dense" "$t" "$N" "$steps" "$work/lmp$t.txt")"
+    else lm="$(lammps_rate "$work/in.dense" "$t" "$N" "$steps" "$work/lmp$t.txt")"; fl="$(fabriclab_rate "$t")"; fi
     ratio="$(awk -v a="$fl" -v b="$lm" 'BEGIN {printf "%.4f", a / b}')"
     printf "%-7s %-20s %14.4e %14.4e %8.2f\n" "$k" "$t / $t" "$fl" "$lm" "$ratio"
     echo "$t $fl $lm $ratio" >>"$work/pairs.txt"
@@ -138,10 +96,7 @@ echo
 printf "step 0          %16s %16s\n" "FabricLab" "LAMMPS"
 printf "  p [Pa]        %16.6f %16.6f\n" "$fl_p0" "$lmp_p0"
 printf "  Z = 2C/N      %16.6f %16.6f\n" "$fl_z0" "$lmp_z0"
-awk -v a="$fl_p0" -v b="$lmp_p0" -v c="$fl_z0" -v d="$lmp_z0" 'BEGIN {
-  dp = (a - b) / b; if (dp < 0) dp = -dp; dz = (c - d) / d; if (dz < 0) dz = -dz;
-  printf "  relative difference: p %.2e, Z %.2e\n", dp, dz; exit !(dp <= 0.01 && dz <= 0.01) }' ||
-  die "FabricLab and LAMMPS disagree by more than 1 % at step 0: not the same scene"
+check_same_scene "$fl_p0" "$fl_z0" "$lmp_p0" "$lmp_z0"
 
 # ---- 7. the numbers ---------------------------------------------------------------------------------
 echo
