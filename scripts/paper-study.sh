@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Runs the paper's whole study at full size: both specimens, the four consolidation histories and the
-# eight cyclic runs of Table 2, as many at a time as there are cores (one thread each), reusing whatever
-# is already prepared in out/paper/ (a step whose stages.json lists all its stages is skipped).
+# eight cyclic runs of Table 2, reusing whatever is already prepared in out/paper/ (a step whose stages.json
+# lists all its stages is skipped). A step that nothing else can run beside (a specimen, the anisotropic
+# history) takes JOBS threads; the others run JOBS at a time, one thread each. Results do not depend on the
+# thread count (the same bits, tests/determinism_test.cpp).
 # Usage: scripts/paper-study.sh [JOBS]       (expect hours on a 2-core machine; see docs/performance.md)
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -15,11 +17,11 @@ done_already() {  # scene name -> true if its results folder holds a complete st
   want=$(grep -c '"type"' "$scenes/$1.json")
   [ -f "$out/stages.json" ] && [ "$(grep -c '"type"' "$out/stages.json")" -ge "$want" ]
 }
-run_one() {
-  local name="$1"
+run_one() {  # scene name [threads, default 1]
+  local name="$1" threads="${2:-1}"
   if done_already "$name"; then echo "== $name: already done"; return 0; fi
-  echo "== $name: running"
-  "$bin" "$scenes/$name.json" --threads 1 --overwrite --quiet > "$root/out/paper/$name.log" 2>&1 \
+  echo "== $name: running on $threads thread(s)"
+  "$bin" "$scenes/$name.json" --threads "$threads" --overwrite --quiet > "$root/out/paper/$name.log" 2>&1 \
     && echo "== $name: done" || { echo "== $name: FAILED (see out/paper/$name.log)"; return 1; }
 }
 export -f run_one done_already
@@ -29,10 +31,11 @@ mkdir -p "$root/out/paper"
 # A failed step does not stop the others that do not need it, nor the report (which lists it as not run);
 # the script's exit status is then 1.
 failed=0
-run_one specimen-isotropic || failed=1
-printf '%s\n' specimen-anisotropic history-isotropic-isotropic history-isotropic-k0 history-isotropic-ocr |
+run_one specimen-isotropic "$jobs" || failed=1
+printf '%s\n' history-isotropic-isotropic history-isotropic-k0 history-isotropic-ocr |
   xargs -P "$jobs" -I{} bash -c 'run_one {}' || failed=1
-run_one history-anisotropic-isotropic || failed=1
+run_one specimen-anisotropic "$jobs" || failed=1
+run_one history-anisotropic-isotropic "$jobs" || failed=1
 ls "$scenes" | sed -n 's/^\(run-.*\)\.json$/\1/p' | xargs -P "$jobs" -I{} bash -c 'run_one {}' || failed=1
 [ "$failed" = 0 ] && echo "study complete: results in out/paper/" || echo "study finished with failures (see out/paper/*.log)"
 # (The run-*.json glob above also picks up the optional Mindlin–Deresiewicz runs run-*-md.json of issue 9
