@@ -8,7 +8,7 @@ ensure_lammps() {
     local sudo=""
     [[ $(id -u) -ne 0 ]] && sudo="sudo"
     echo "installing Debian's lammps ..." >&2
-    $sudo apt-get update -qq
+    $sudo apt-get update -qq >&2  # stdout carries the version only
     DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y --no-install-recommends lammps openmpi-bin >/dev/null
   fi
   command -v mpirun >/dev/null || die "mpirun not found (Debian package openmpi-bin)"
