@@ -37,13 +37,12 @@ build_bench "$root" "$build" bench_dense
 cache="$root/build/bench-cache/dense4000_318kPa.state"  # shared with lammps_side_by_side.sh and scaling.sh
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
-tiles="1,1,1 2,2,2 4,4,4 6,6,7"
+t1="${threads%%,*}"  # the thread count whose LAMMPS log the step-0 check reads
 
 echo "== the scenes: exported by bench_dense, the same physics written for LAMMPS $lmp_version =="
-for tile in $tiles; do
-  IFS=, read -r a b c <<<"$tile"
-  n=$((4000 * a * b * c))
-  steps=$(awk -v p="$psteps" -v n="$n" 'BEGIN { s = int(p / n); if (s < 50) s = 50; print s }')
+for tile in $scaling_tiles; do
+  n="$(tile_spheres "$tile")"
+  steps="$(run_steps "$psteps" "$n" 50)"
   "$bench" --cache "$cache" --tile "$tile" --export-lammps "$work/$n.data" --steps 1 --repeats 1 --threads 1 \
     >"$work/export$n.txt" 2>&1 || { tail -20 "$work/export$n.txt" >&2; die "bench_dense failed to export N=$n"; }
   line="$(grep '^export:' "$work/export$n.txt")" || die "bench_dense printed no export line for N=$n"
@@ -62,49 +61,44 @@ lammps_ns() {  # N steps ranks -> ns per particle-step of one run
   rate="$(lammps_rate "$work/in$1" "$3" "$1" "$2" "$work/lmp$1_$3.txt")"
   awk -v r="$rate" 'BEGIN {printf "%.3f\n", 1e9 / r}'
 }
+same_scene_at_step0() {  # N: both codes' p and Z at step 0 (LAMMPS's from its last run on $t1 ranks)
+  local line lmp_p0 lmp_z0
+  line="$(cat "$work/line$1.txt")"
+  lmp_p0="$(sed -n 's/^STEP0 p=\([^ ]*\) .*/\1/p' "$work/lmp$1_$t1.txt")"
+  lmp_z0="$(sed -n 's/^STEP0 .* Z=\(.*\)/\1/p' "$work/lmp$1_$t1.txt")"
+  printf "  step 0, N=%s: FabricLab p %.6f Pa Z %.6f, LAMMPS p %.6f Pa Z %.6f\n" "$1" "$(export_field "$line" p0)" \
+    "$(export_field "$line" Z0)" "$lmp_p0" "$lmp_z0"
+  check_same_scene "$(export_field "$line" p0)" "$(export_field "$line" Z0)" "$lmp_p0" "$lmp_z0"
+}
 
 echo
 echo "== rounds: at each size and thread count, FabricLab and LAMMPS back to back =="
 : >"$work/runs.txt"  # N threads fabriclab_ns lammps_ns
 for ((r = 1; r <= rounds; ++r)); do
-  for tile in $tiles; do
-    IFS=, read -r a b c <<<"$tile"
-    n=$((4000 * a * b * c))
-    steps=$(awk -v p="$psteps" -v n="$n" 'BEGIN { s = int(p / n); if (s < 50) s = 50; print s }')
+  for tile in $scaling_tiles; do
+    n="$(tile_spheres "$tile")"
+    steps="$(run_steps "$psteps" "$n" 50)"
     for t in ${threads//,/ }; do
       if ((r % 2)); then fl="$(fabriclab_ns "$n" "$tile" "$steps" "$t")"; lm="$(lammps_ns "$n" "$steps" "$t")"
       else lm="$(lammps_ns "$n" "$steps" "$t")"; fl="$(fabriclab_ns "$n" "$tile" "$steps" "$t")"; fi
       [[ -n "$fl" && -n "$lm" ]] || die "no time for N=$n, $t thread(s)"
       printf "round %d: N=%-8s threads/ranks=%s  FabricLab %8.1f  LAMMPS %8.1f ns/p-step\n" "$r" "$n" "$t" "$fl" "$lm"
       echo "$n $t $fl $lm" >>"$work/runs.txt"
+      # the same scene in both codes, checked at the first round rather than after all of them
+      if ((r == 1)) && [[ "$t" == "$t1" ]]; then same_scene_at_step0 "$n"; fi
     done
   done
-done
-
-echo
-echo "== step 0 at each size (LAMMPS 1 rank's last run) =="
-for tile in $tiles; do
-  IFS=, read -r a b c <<<"$tile"
-  n=$((4000 * a * b * c))
-  line="$(cat "$work/line$n.txt")"
-  t1="${threads%%,*}"
-  lmp_p0="$(sed -n 's/^STEP0 p=\([^ ]*\) .*/\1/p' "$work/lmp${n}_$t1.txt")"
-  lmp_z0="$(sed -n 's/^STEP0 .* Z=\(.*\)/\1/p' "$work/lmp${n}_$t1.txt")"
-  printf "N=%-8s FabricLab p %.6f Pa Z %.6f   LAMMPS p %.6f Pa Z %.6f\n" "$n" "$(export_field "$line" p0)" \
-    "$(export_field "$line" Z0)" "$lmp_p0" "$lmp_z0"
-  check_same_scene "$(export_field "$line" p0)" "$(export_field "$line" Z0)" "$lmp_p0" "$lmp_z0"
 done
 
 echo
 printf "%-10s %-8s %14s %10s %14s %10s %14s\n" "N" "threads" "FabricLab ns" "vs 4k" "LAMMPS ns" "vs 4k" \
   "FL/LAMMPS rate"
 declare -A fl4 lm4
-for tile in $tiles; do
-  IFS=, read -r a b c <<<"$tile"
-  n=$((4000 * a * b * c))
+sel() { awk -v n="$1" -v t="$2" -v c="$3" '$1 == n && $2 == t {print $c}' "$work/runs.txt"; }  # N threads column
+for tile in $scaling_tiles; do
+  n="$(tile_spheres "$tile")"
   for t in ${threads//,/ }; do
-    sel() { awk -v n="$n" -v t="$t" -v c="$1" '$1 == n && $2 == t {print $c}' "$work/runs.txt"; }
-    fl="$(sel 3 | median)"; lm="$(sel 4 | median)"
+    fl="$(sel "$n" "$t" 3 | median)"; lm="$(sel "$n" "$t" 4 | median)"
     [[ -z "${fl4[$t]:-}" ]] && fl4[$t]="$fl" && lm4[$t]="$lm"
     printf "%-10s %-8s %14.1f %10.3f %14.1f %10.3f %14.2f\n" "$n" "$t" "$fl" \
       "$(awk -v a="$fl" -v b="${fl4[$t]}" 'BEGIN{print a/b}')" "$lm" \

@@ -28,13 +28,11 @@ build_bench "$root" "$build" bench_dense
 cache="$root/build/bench-cache/dense4000_318kPa.state"  # shared with lammps_side_by_side.sh
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
-tiles="1,1,1 2,2,2 4,4,4 6,6,7"
 : >"$out/runs.txt"  # N threads rate ns bytes, one line per run
 for ((r = 1; r <= rounds; ++r)); do
-  for tile in $tiles; do
-    IFS=, read -r a b c <<<"$tile"
-    n=$((4000 * a * b * c))
-    steps=$(awk -v p="$psteps" -v n="$n" 'BEGIN { s = int(p / n); if (s < 100) s = 100; print s }')
+  for tile in $scaling_tiles; do
+    n="$(tile_spheres "$tile")"
+    steps="$(run_steps "$psteps" "$n" 100)"
     (cd "$root" && "$bench" --cache "$cache" --tile "$tile" --threads "$threads" --steps "$steps" \
       --repeats 1) >"$out/$n.txt" 2>&1 || { tail -20 "$out/$n.txt"; exit 1; }
     sed -n "s/^result: threads=\([0-9]*\) rate=\([^ ]*\) ns_per_particle_step=\([^ ]*\) N=[0-9]* bytes_per_particle=\([^ ]*\).*/$n \1 \2 \3 \4/p" \
@@ -45,9 +43,8 @@ echo
 printf '%-10s %-8s %14s %12s %10s %16s %12s %12s\n' "N" "threads" "p-steps/s" "ns/p-step" "vs 4k" "ns min-max" \
   "best vs 4k" "bytes/part."
 declare -A base best ns1
-for tile in $tiles; do
-  IFS=, read -r a b c <<<"$tile"
-  n=$((4000 * a * b * c))
+for tile in $scaling_tiles; do
+  n="$(tile_spheres "$tile")"
   for t in ${threads//,/ }; do
     sel() { awk -v n="$n" -v t="$t" -v c="$1" '$1 == n && $2 == t {print $c}' "$out/runs.txt"; }
     rate="$(sel 3 | median)"; ns="$(sel 4 | median)"; bpp="$(sel 5 | head -1)"
