@@ -28,7 +28,7 @@ AxisServo::AxisServo(const std::array<AxisControl, 3>& axes, const ServoSettings
 
 Mat3 AxisServo::update(const Simulation& sim) {
   const Mat3& s = sim.contactStress();
-  const Vec3& K = sim.diagnostics().axisStiffness;
+  const Vec3& K = sim.axisStiffness();  // the pass's sum: nothing is measured per step
   const double dt = sim.timeStep();
   const double cap = m_settings.maxStrainRate;
   for (int k = 0; k < 3; ++k) {

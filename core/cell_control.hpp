@@ -6,7 +6,7 @@
 // Coupling: isochoric() makes eps_dot_x = eps_dot_y = -eps_dot_z / 2 (constant volume, the paper's
 // 'idealised undrained' shearing); K0 is x, y at StrainRate 0 with z under Stress or MeanStress.
 // Servo law (per step): d eps_k = gain * (target - sigma_kk) / K_k, with K_k the packing's tangent
-// stiffness for that axis (Simulation::diagnostics().axisStiffness; for MeanStress K_k / 3), then
+// stiffness for that axis (Simulation::axisStiffness(), summed by the pass; for MeanStress K_k / 3), then
 // eps_dot = d eps / dt clamped to +-maxStrainRate. With no contacts (a gas) the axis moves at the cap.
 // Done: every stress-controlled axis within stressTolerance (relative to its target, or absolute
 // tolerance below 1 Pa targets) and the unbalanced-force ratio below unbalancedTolerance.

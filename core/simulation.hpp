@@ -101,6 +101,13 @@ class Simulation {
     measureContacts();
     return m_diag;
   }
+  // What every pass sums itself (either law), read without measuring the contacts: the servo's per-step
+  // inputs. diagnostics() reads the rest off all stored contacts, serially, so a controller that called it
+  // every step paid a measurement per step (11-17 % of a servo-controlled run; docs/performance.md).
+  const Vec3& axisStiffness() const { return m_diag.axisStiffness; }
+  // true once the diagnostics' extremes and the elastic energies of the last pass have been read off the
+  // contacts (or the pass summed them itself): a step that nobody measured leaves it false
+  bool contactsMeasured() const { return m_contactsMeasured; }
   const StageProfile& profile() const { return m_profile; }
   // Heap bytes held by the state (particle and pair arrays by capacity, history, adjacency, reduction
   // chunks); the neighbour grid is a temporary of each rebuild and not counted.
