@@ -330,9 +330,11 @@ int main(int argc, char** argv) {
   std::printf("\nmemory: %.0f bytes per particle in the engine's arrays (Simulation::memoryBytes); process "
               "resident %.0f MB after the first run (includes the cached packing and LAMMPS-export scene)\n",
               memoryPerParticle, peakResident / 1e6);
-  std::printf("%-8s %14s %14s %14s %10s\n", "threads", "median p-st/s", "min", "max", "rebuilds");
+  std::printf("%-8s %14s %14s %14s %10s %14s\n", "threads", "median p-st/s", "min", "max", "rebuilds",
+              "stolen/step");
   for (const Result& r : results)
-    std::printf("%-8d %14.4e %14.4e %14.4e %10ld\n", r.threads, r.median, r.lo, r.hi, r.profile.rebuilds);
+    std::printf("%-8d %14.4e %14.4e %14.4e %10ld %14.2f\n", r.threads, r.median, r.lo, r.hi, r.profile.rebuilds,
+                static_cast<double>(r.profile.stolenRuns) / static_cast<double>(std::max(1L, r.profile.steps)));
   for (const Result& r : results) {
     std::printf("profile, %d thread(s) [s, share]:", r.threads);
     const double tot = r.profile.total();

@@ -92,11 +92,10 @@ void Simulation::syncTangentialHistory() {
 template <bool kEnergy, bool kDamping, bool kAffine, bool kMD>
 void Simulation::contactPass() {
   if constexpr (kMD) contactPassMindlinDeresiewicz<kEnergy, kDamping, kAffine>();
-  else if (threadBoundary().exchange) contactPassBlocked<kEnergy, kDamping, kAffine, true>();
-  else contactPassBlocked<kEnergy, kDamping, kAffine, false>();
+  else contactPassBlocked<kEnergy, kDamping, kAffine>();
 }
 
-template <bool kEnergy, bool kDamping, bool kAffine, bool kHalo>
+template <bool kEnergy, bool kDamping, bool kAffine>
 void Simulation::contactPassBlocked() {
   // Three phases per block of listed pairs, all within one reduction chunk (so the bits do not depend on
   // the thread count): 1. gather the touching pairs' inputs into a PairBlock (branch-free compaction);
@@ -111,28 +110,13 @@ void Simulation::contactPassBlocked() {
   const PassParticle* pass = arr.pp;
   const PairTable& table = m_pairs;
   Chunk* chunks = m_chunks.data();
-  const ThreadBoundary& tb = threadBoundary();
-  PassParticle* haloPass = m_haloPass.data();
-  Vec3* haloW = m_haloW.data();
-  KickSeed* seeds = m_seeds.data();
-  const auto n = static_cast<std::int32_t>(arr.n);
-  int team = 0;
+  const std::int32_t* partner = arr.second;
+  const Vec3* omega = arr.w;
+  updateShares();
+  m_ranges.reset(m_chunkShares, 1);
 #pragma omp parallel num_threads(m_num.threads)
   {
     const int t = omp_get_thread_num(), nt = omp_get_num_threads();
-    if (t == 0) team = nt;
-    // with the boundary of this team: each owner first copies the partners other threads read into the halo
-    // (thread_boundary.hpp), and the pass reads them there
-    const bool exchange = nt == tb.threads && tb.exchange;
-    if (exchange) {
-      for (std::size_t q = tb.haloBegin[t]; q < tb.haloBegin[t + 1]; ++q) {
-        const std::int32_t j = tb.halo[q];
-        haloPass[q] = pass[j];
-        haloW[q] = arr.w[j];
-      }
-#pragma omp barrier
-    }
-    const std::int32_t* partner = exchange ? tb.partner.data() : arr.second;
     kernels::PairBlock b{};  // per thread, ~23 KiB: stays in L1 through the three phases
     std::int32_t index[kernels::kBlockPairs];  // pair of each slot
     // one material (the paper's scenes): every pair has the same parameters, written into all the block's
@@ -146,25 +130,16 @@ void Simulation::contactPassBlocked() {
       std::fill_n(b.dampingRatio, kernels::kBlockPairs, pp.dampingRatio);
     }
     // the partners to prefetch: all of them when the state outgrows the caches (kPrefetchAllFrom), else those
-    // in the halo or from the first particle a later thread drifts on (none for the last thread)
-    const bool remote = t + 1 < nt || arr.n >= kPrefetchAllFrom;
-    const std::int32_t remoteFrom = arr.n >= kPrefetchAllFrom ? 0
-                                    : exchange                ? n
-                                    : t + 1 < nt              ? particleShare(tb, t + 1, nt).first
-                                                              : n;
-    const std::size_t kBegin = exchange ? tb.chunkBegin[t] : staticBegin(t, nt, nchunks);
-    const std::size_t kEnd = exchange ? tb.chunkBegin[t + 1] : staticBegin(t + 1, nt, nchunks);
-    // partners through the halo only when there is one (kHalo): one thread pays no select
-    const Vec3* omega = arr.w;
-    const auto passOf = [pass, haloPass, n](std::int32_t jn) -> const PassParticle& {
-      if constexpr (kHalo) return jn < n ? pass[jn] : haloPass[jn - n];
-      return pass[jn];
-    };
-    const auto omegaOf = [omega, haloW, n](std::int32_t jn) -> const Vec3& {
-      if constexpr (kHalo) return jn < n ? omega[jn] : haloW[jn - n];
-      return omega[jn];
-    };
-    for (std::size_t k = kBegin; k < kEnd; ++k) {
+    // outside this thread's own particles (another core drifted them; none with one thread)
+    const bool all = arr.n >= kPrefetchAllFrom;
+    const bool remote = all || nt > 1;
+    const bool own = nt == m_sharesThreads;
+    const auto ownFrom = static_cast<std::uint32_t>(own ? m_particleShares[t] : staticBegin(t, nt, arr.n));
+    const auto ownTo = static_cast<std::uint32_t>(own ? m_particleShares[t + 1] : staticBegin(t + 1, nt, arr.n));
+    const std::uint32_t ownSpan = all ? 0 : ownTo - ownFrom;  // every partner lies outside an empty span
+    ThreadRuns runs(m_ranges, t, nt, nchunks);  // the chunks this thread computes, run by run
+    for (std::size_t runBegin, runEnd; runs.next(runBegin, runEnd);)
+    for (std::size_t k = runBegin; k < runEnd; ++k) {
       Chunk acc;
       kernels::BlockSums sums;
       const std::size_t chunkEnd = std::min(np, (k + 1) * kChunk);
@@ -177,9 +152,9 @@ void Simulation::contactPassBlocked() {
         if (remote)
           for (std::size_t q = p1, qEnd = std::min(np, p1 + kernels::kBlockPairs); q < qEnd; ++q) {
             const std::int32_t jn = partner[q];
-            if (jn >= remoteFrom) {
-              __builtin_prefetch(&passOf(jn));
-              __builtin_prefetch(&omegaOf(jn));
+            if (static_cast<std::uint32_t>(jn) - ownFrom >= ownSpan) {
+              __builtin_prefetch(pass + jn);
+              __builtin_prefetch(omega + jn);
             }
           }
         // 1a. geometry of every listed pair: each is written to slot m, which advances only for a touching
@@ -189,8 +164,7 @@ void Simulation::contactPassBlocked() {
         std::uint64_t touchingNow = 0;
         for (std::size_t p = p0; p < p1; ++p) {
           const int i = arr.first[p];
-          const std::int32_t jn = partner[p];
-          const PassParticle& pj = passOf(jn);
+          const PassParticle& pj = pass[partner[p]];
           Vec3 d = pj.x - pass[i].x;  // l = x_j + H image - x_i
           const Image img = arr.image[p];
           if (!img.isZero()) d += arr.cell.shift(img.vec());
@@ -210,8 +184,8 @@ void Simulation::contactPassBlocked() {
           const std::size_t p = static_cast<std::size_t>(index[s]);
           const int i = arr.first[p];
           const std::int32_t jn = partner[p];
-          const PassParticle& pj = passOf(jn);
-          const Vec3& wj = omegaOf(jn);
+          const PassParticle& pj = pass[jn];
+          const Vec3& wj = omega[jn];
           // relative velocity of the centres, with the mean field L·d, which carries the image shift
           // velocity L·H·n for pairs across the boundary (verification ladder §2)
           Vec3 vr = pj.v - pass[i].v;
@@ -261,20 +235,8 @@ void Simulation::contactPassBlocked() {
       }
       chunks[k] = acc;
     }
-    // the seeds this thread owes: the leading adjacency entries of other threads' particles, which it computed
-    if (exchange)
-      for (std::size_t q = tb.seedBegin[t]; q < tb.seedBegin[t + 1]; ++q) {
-        const std::int32_t i = tb.seedParticle[q];
-        const double ri = m_p.radius[i];  // not pass[i]: its owner's line
-        double fx = 0.0, fy = 0.0, fz = 0.0, tx = 0.0, ty = 0.0, tz = 0.0;
-        for (std::int32_t e = m_c.adjStart[i]; e < tb.kickBegin[i]; ++e) {
-          const std::int32_t entry = m_c.adjEntry[e];
-          kickEntry(arr.result[entry >> 1], entry, ri, fx, fy, fz, tx, ty, tz);
-        }
-        seeds[q] = {fx, fy, fz, tx, ty, tz};
-      }
   }
-  m_seedsReady = team == tb.threads && tb.exchange;
+  m_profile.stolenRuns += static_cast<long>(m_ranges.stolen());
   // the diagnostics' extremes and means and the elastic energies are read off the stored contacts on demand
   reduceContactChunks<kEnergy, false>(nchunks);
 }
@@ -290,8 +252,13 @@ void Simulation::contactPassMindlinDeresiewicz() {
   MdHistory* mdHist = m_c.mdHistory.data();
   const PairTable& table = m_pairs;
   Chunk* chunks = m_chunks.data();
-#pragma omp parallel for num_threads(m_num.threads) schedule(static)
-  for (std::size_t k = 0; k < nchunks; ++k) {
+  updateShares();
+  m_ranges.reset(m_chunkShares, 1);
+#pragma omp parallel num_threads(m_num.threads)
+  {
+  ThreadRuns runs(m_ranges, omp_get_thread_num(), omp_get_num_threads(), nchunks);
+  for (std::size_t runBegin, runEnd; runs.next(runBegin, runEnd);)
+  for (std::size_t k = runBegin; k < runEnd; ++k) {
     Chunk acc;
     const std::size_t end = std::min(np, (k + 1) * kChunk);
     for (std::size_t p = k * kChunk; p < end; ++p) {
@@ -374,6 +341,8 @@ void Simulation::contactPassMindlinDeresiewicz() {
     }
     chunks[k] = acc;
   }
+  }
+  m_profile.stolenRuns += static_cast<long>(m_ranges.stolen());
   reduceContactChunks<kEnergy, true>(nchunks);
 }
 

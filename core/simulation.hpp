@@ -11,7 +11,8 @@
 //   4. kick       forces gathered per particle in a fixed order, half kick v += dt/2 a
 //   5. control    the cell controller (if any) sets L for the next step
 // Deterministic: every reduction is over fixed-size chunks summed in chunk order, and forces are gathered
-// per particle from the CSR adjacency, so the bits do not depend on the thread count.
+// per particle from the CSR adjacency, so the bits do not depend on the thread count, nor on which thread
+// computed what: the parallel loops balance their work between the threads as they go (work_stealing.hpp).
 // Stress sign: compression positive (soil mechanics), sigma = (1/V) sum_c f_c (x) l_c with f_c the force
 // on j and l_c the branch vector from i to j.
 #pragma once
@@ -29,7 +30,7 @@
 #include "numerics.hpp"
 #include "particle_store.hpp"
 #include "periodic_cell.hpp"
-#include "thread_boundary.hpp"
+#include "work_stealing.hpp"
 
 namespace fl {
 
@@ -44,6 +45,7 @@ struct StageProfile {
   std::array<double, static_cast<int>(Stage::Count)> seconds{};
   long steps = 0;
   long rebuilds = 0;
+  long stolenRuns = 0;  // runs of a parallel loop one thread took from another's share (work_stealing.hpp)
   double total() const;
 };
 
@@ -156,8 +158,8 @@ class Simulation {
   template <bool kEnergy, bool kDamping, bool kAffine, bool kMindlinDeresiewicz>
   void contactPass();  // selects one of the two below
   // Default law: pairs gathered into blocks of touching pairs, law vectorised across them (contact_block.hpp).
-  template <bool kEnergy, bool kDamping, bool kAffine, bool kHalo>
-  void contactPassBlocked();  // kHalo: partners of other threads' shares are read from the halo
+  template <bool kEnergy, bool kDamping, bool kAffine>
+  void contactPassBlocked();
   // Mindlin–Deresiewicz law: one pair at a time (its branch history does not vectorise).
   template <bool kEnergy, bool kDamping, bool kAffine>
   void contactPassMindlinDeresiewicz();
@@ -173,14 +175,13 @@ class Simulation {
   // switching to it, fresh histories start from the stored normal forces).
   void syncTangentialHistory();
   void kick();
-  template <bool kLocalDamping, bool kSeeded>
+  template <bool kLocalDamping>
   void kickPass();
-  // The threads' shares and what crosses between them, for m_num.threads (thread_boundary.hpp); built after
-  // each rebuild or restore and when the thread count changes. A parallel region whose team is not that
-  // size splits the particles statically and reads everything in place.
-  const ThreadBoundary& threadBoundary();
-  // thread t's share [first, second) of the particles in a team of nt
-  std::pair<int, int> particleShare(const ThreadBoundary& tb, int t, int nt) const;
+  // The threads' own shares of the pair chunks (a static split) and of the particles (each thread's starting
+  // where the pairs of its first chunk start, so that it drifts and kicks the particles whose pairs it computes
+  // as first particle), for m_num.threads; made again after each rebuild or restore and when the thread count
+  // changes. The parallel loops start from them and balance from there (work_stealing.hpp).
+  void updateShares();
 
   ParticleStore m_p;
   std::vector<PassParticle> m_pass;  // the contact pass's copy of x, r, v, 1/m (particle_store.hpp)
@@ -223,9 +224,9 @@ class Simulation {
   static constexpr int kPrefetchAhead = 32;
   // How far ahead (adjacency entries) the kick prefetches the result lines it will gather: ~16 particles of
   // the dense packing's ~8.7 listed pairs each, ~200 ns of the kick's work (35 entries left the second
-  // thread, which gathers the results the first wrote across the boundary, 20 % slower). Only lines an
-  // earlier thread's pass wrote, or all from kPrefetchAllFrom particles: with one thread at 4000 spheres,
-  // prefetching every entry cost 2-7 % of a step.
+  // thread, which gathers the results the first wrote across the boundary, 20 % slower). Only the lines of
+  // pairs outside the thread's own share of the pass (another core most likely wrote them), or all from
+  // kPrefetchAllFrom particles: with one thread at 4000 spheres, prefetching every entry cost 2-7 % of a step.
   static constexpr int kPrefetchEntries = 140;
   // Partial sums of one fixed block of pairs (or particles), reduced in block order.
   struct Chunk {
@@ -240,11 +241,13 @@ class Simulation {
   // the kick's local-damping work terms of each particle (3 per particle, in the order the serial sum adds
   // them), summed per fixed chunk of particles after the kick: the threads' shares need not fall on chunks
   std::vector<double> m_kickWork;
-  ThreadBoundary m_boundary;
-  std::vector<PassParticle> m_haloPass;  // halo slots: the pass copy and omega of other threads' partners
-  std::vector<Vec3> m_haloW;
-  std::vector<KickSeed> m_seeds;  // slot 0 stays zero
-  bool m_seedsReady = false;      // the last pass summed the seeds for this team
+  // Runs of particles a thread claims at a time in the drift and the kick: ~0.9 µs of drift and ~2.6 µs of kick
+  // work at ~14 and ~41 ns a particle (4000 spheres, one thread), against a claim's ~10 ns (an atomic on a line
+  // its own thread holds); 32 and 128 were no better (docs/performance.md, twelfth session).
+  static constexpr std::size_t kParticleGrain = 64;
+  std::vector<std::size_t> m_chunkShares, m_particleShares;  // threads + 1 bounds each (updateShares)
+  int m_sharesThreads = 0;  // the team size the shares are for; 0: to be made
+  StealingRanges m_ranges;  // the claims of the current parallel loop
 };
 
 }  // namespace fl

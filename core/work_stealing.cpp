@@ -1,0 +1,69 @@
+// Runs of a loop's items claimed by their owner and stolen by its neighbour (work_stealing.hpp).
+#include "work_stealing.hpp"
+
+#include <algorithm>
+#include <cassert>
+
+namespace fl {
+
+namespace {
+constexpr std::uint64_t pack(std::uint64_t front, std::uint64_t back) { return back << 32 | front; }
+constexpr std::uint64_t frontOf(std::uint64_t w) { return w & 0xffffffffu; }
+constexpr std::uint64_t backOf(std::uint64_t w) { return w >> 32; }
+}  // namespace
+
+void StealingRanges::reset(const std::vector<std::size_t>& bounds, std::size_t grain) {
+  assert(bounds.size() >= 2 && bounds.back() < (std::size_t{1} << 32) && grain >= 1);
+  const int nt = static_cast<int>(bounds.size()) - 1;
+  if (nt > m_capacity) {
+    m_shares = std::make_unique<Share[]>(static_cast<std::size_t>(nt));
+    m_capacity = nt;
+  }
+  m_threads = nt;
+  m_grain = grain;
+  for (int t = 0; t < nt; ++t) {
+    m_shares[t].bounds.store(pack(bounds[t], bounds[t + 1]), std::memory_order_relaxed);
+    m_shares[t].stolen.store(0, std::memory_order_relaxed);
+  }
+}
+
+std::size_t StealingRanges::stolen() const {
+  std::size_t n = 0;
+  for (int t = 0; t < m_threads; ++t) n += m_shares[t].stolen.load(std::memory_order_relaxed);
+  return n;
+}
+
+bool StealingRanges::claimFront(Share& s, std::size_t& begin, std::size_t& end) const {
+  std::uint64_t w = s.bounds.load(std::memory_order_relaxed);
+  for (;;) {
+    const std::uint64_t f = frontOf(w), b = backOf(w);
+    if (f >= b) return false;
+    const std::uint64_t e = std::min(b, f + m_grain);
+    if (s.bounds.compare_exchange_weak(w, pack(e, b), std::memory_order_relaxed)) {
+      begin = f, end = e;
+      return true;
+    }
+  }
+}
+
+bool StealingRanges::claimBack(Share& s, std::size_t& begin, std::size_t& end) const {
+  std::uint64_t w = s.bounds.load(std::memory_order_relaxed);
+  for (;;) {
+    const std::uint64_t f = frontOf(w), b = backOf(w);
+    if (f >= b) return false;
+    const std::uint64_t q = b - std::min(b - f, m_grain);
+    if (s.bounds.compare_exchange_weak(w, pack(f, q), std::memory_order_relaxed)) {
+      s.stolen.fetch_add(1, std::memory_order_relaxed);
+      begin = q, end = b;
+      return true;
+    }
+  }
+}
+
+bool StealingRanges::next(int t, std::size_t& begin, std::size_t& end) {
+  if (claimFront(m_shares[t], begin, end)) return true;
+  if (m_threads < 2) return false;
+  return claimBack(m_shares[(t + m_threads - 1) % m_threads], begin, end);
+}
+
+}  // namespace fl

@@ -1,0 +1,82 @@
+// Dynamic balance of the step's parallel loops (issue 6: the 2-thread speed-up on shared hosts).
+//
+// Each thread owns a contiguous share of the items of one loop (particles, or chunks of pairs) and claims it
+// run by run from its front; once its own share is empty it takes runs from the back of the share before its
+// own (thread t - 1, thread 0 from the last one), whose back borders its own front. So a thread the host slows
+// down for a while hands its last runs to the other instead of making the whole step wait for it at the
+// region's end, and each thread still works on items next to its own (its caches, its Z-ordered neighbours).
+// On 2-vCPU VMs whose vCPUs slow down one at a time for tens of milliseconds, the two threads' busy times in one
+// pass differed by a factor 0.7-1.6 from step to step (docs/performance.md, twelfth session).
+//
+// Which thread computes an item never changes the bits: each item writes only its own results (a pair's line,
+// a chunk's partial sums, a particle's state), and every sum over items is taken afterwards in item order.
+// Claims are one atomic word per share (front and back packed), so a run is taken exactly once; the data the
+// items write reach the other threads through the region's barriers, not through these atomics.
+#pragma once
+
+#include <algorithm>
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace fl {
+
+// Where share t of nt starts in `count` items split statically: contiguous runs, the first count % nt one
+// longer (as schedule(static) in libgomp and libomp).
+inline std::size_t staticBegin(int t, int nt, std::size_t count) {
+  const std::size_t q = count / static_cast<std::size_t>(nt), r = count % static_cast<std::size_t>(nt);
+  const std::size_t k = static_cast<std::size_t>(t);
+  return k * q + std::min(k, r);
+}
+
+class StealingRanges {
+ public:
+  // Serial, before the region: shares [bounds[t], bounds[t+1]) of bounds.size() - 1 threads (ascending, at most
+  // 2^32 - 1 items), claimed in runs of `grain` items (>= 1).
+  void reset(const std::vector<std::size_t>& bounds, std::size_t grain);
+  // In the region, thread t: its next run [begin, end), from its own share's front, else from the back of the
+  // share before it; false when both are empty (the thread is done with this loop).
+  bool next(int t, std::size_t& begin, std::size_t& end);
+  int threads() const { return m_threads; }
+  // Serial, after the region: runs taken from another thread's share since the last reset.
+  std::size_t stolen() const;
+
+ private:
+  // front (low 32 bits) and back (high 32 bits) of the unclaimed run of one share, on its own cache line
+  struct alignas(64) Share {
+    std::atomic<std::uint64_t> bounds{0};
+    std::atomic<std::uint32_t> stolen{0};  // runs taken from its back, on the line the thief just took
+  };
+  bool claimFront(Share& s, std::size_t& begin, std::size_t& end) const;
+  bool claimBack(Share& s, std::size_t& begin, std::size_t& end) const;
+
+  std::unique_ptr<Share[]> m_shares;
+  int m_capacity = 0, m_threads = 0;
+  std::uint64_t m_grain = 1;
+};
+
+// The runs one thread takes of a loop: for (std::size_t b, e; runs.next(b, e);) { ... items [b, e) ... }. From the
+// ranges when they were set for a team of this size (of 2 or more), else its static share of `count` items,
+// whole. A plain loop, not a callback: the step's loops inside lambdas ran ~10 % slower (docs/performance.md).
+class ThreadRuns {
+ public:
+  ThreadRuns(StealingRanges& ranges, int t, int nt, std::size_t count)
+      : m_ranges(nt > 1 && nt == ranges.threads() ? &ranges : nullptr), m_t(t),
+        m_begin(staticBegin(t, nt, count)), m_end(staticBegin(t + 1, nt, count)) {}
+  bool next(std::size_t& begin, std::size_t& end) {
+    if (m_ranges) return m_ranges->next(m_t, begin, end);
+    if (m_begin >= m_end) return false;
+    begin = m_begin, end = m_end;
+    m_begin = m_end;
+    return true;
+  }
+
+ private:
+  StealingRanges* m_ranges;
+  int m_t;
+  std::size_t m_begin, m_end;
+};
+
+}  // namespace fl
