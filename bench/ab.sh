@@ -4,6 +4,8 @@
 # alternation, ROUNDS times each, and the script prints the median and the best rate of each per thread count.
 # Noise from other tenants only ever slows a run, so the best of many short runs is the steadiest estimate;
 # the upper quartile is printed beside it.
+# With THREADS 1,2 it also prints each build's paired 2-thread speed-ups (each invocation's own ratio: median,
+# range and how many reached issue 6's 1.8).
 # It also says whether the two builds computed the same bits (bench_dense's state fingerprint; older builds
 # without one print "none").
 #
@@ -23,7 +25,8 @@ done
 [[ -f $cache ]] || { echo "bench/ab.sh: no cached packing $cache (run bench_dense once with --cache)" >&2; exit 2; }
 log=$(mktemp)
 err=$(mktemp)
-trap 'rm -f "$log" "$err"' EXIT
+pairs=$(mktemp)
+trap 'rm -f "$log" "$err" "$pairs"' EXIT
 for ((r = 1; r <= rounds; ++r)); do
   # alternate which build goes first, so neither always runs right after the other
   if ((r % 2)); then order=("A:$a" "B:$b"); else order=("B:$b" "A:$a"); fi
@@ -38,6 +41,8 @@ for ((r = 1; r <= rounds; ++r)); do
     fp=$(awk '/^state fingerprint/ { print $NF }' <<<"$out")
     if [[ $tag == A ]]; then fpA=$fp; else fpB=$fp; fi
     awk -v tag="$tag" '/^result:/ { split($2, t, "="); split($3, q, "="); print tag, t[2], q[2] }' <<<"$out" >>"$log"
+    # the speed-up of this invocation (its 1- and 2-thread runs back to back, so both saw the same host)
+    awk -v tag="$tag" '/^speed-up 2 vs 1 threads:/ { print tag, $NF }' <<<"$out" >>"$pairs"
   done
   echo "round $r/$rounds done" >&2
 done
@@ -62,3 +67,17 @@ sort -k1,1 -k2,2n -k3,3g "$log" | awk '
       printf "%-3s %-8s %12.4e %12.4e %12.4e\n", f[1], f[2], med, q, v[key, c]
     }
   }'
+# paired speed-ups (only when THREADS holds 1 and 2): the median of each invocation's own ratio is steadier
+# than the ratio of the medians, which mixes runs from different states of the host
+if [[ -s $pairs ]]; then
+  echo "2-thread speed-up of each invocation (2 vs 1 threads): median, min-max, runs >= 1.8"
+  sort -k1,1 -k2,2g "$pairs" | awk '
+    { v[$1, ++n[$1]] = $2; if (!($1 in seen)) { seen[$1] = 1; keys[++nk] = $1 } if ($2 >= 1.8) ++hit[$1] }
+    END {
+      for (k = 1; k <= nk; ++k) {
+        t = keys[k]; c = n[t]
+        med = (c % 2) ? v[t, (c + 1) / 2] : 0.5 * (v[t, c / 2] + v[t, c / 2 + 1])
+        printf "%-3s %12.3f   %.3f-%.3f   %d of %d\n", t, med, v[t, 1], v[t, c], hit[t] + 0, c
+      }
+    }'
+fi
