@@ -54,14 +54,16 @@ if [[ -n ${fpA:-} && $fpA == "${fpB:-}" ]]; then
 else
   echo "same bits: NO (state fingerprint A ${fpA:-none}, B ${fpB:-none})"
 fi
+# the median of the c sorted values v[key, 1..c] (both summaries below)
+median='function median(v, key, c) { return (c % 2) ? v[key, (c + 1) / 2] : 0.5 * (v[key, c / 2] + v[key, c / 2 + 1]) }'
 # the upper quartile too: between the best (one lucky run) and the median (half the runs slowed by the host)
 printf '%-3s %-8s %12s %12s %12s\n' run threads median 'upper q.' best
-sort -k1,1 -k2,2n -k3,3g "$log" | awk '
+sort -k1,1 -k2,2n -k3,3g "$log" | awk "$median"'
   { key = $1 " " $2; v[key, ++n[key]] = $3; if (!(key in seen)) { seen[key] = 1; keys[++nk] = key } }
   END {
     for (k = 1; k <= nk; ++k) {
       key = keys[k]; c = n[key]
-      med = (c % 2) ? v[key, (c + 1) / 2] : 0.5 * (v[key, c / 2] + v[key, c / 2 + 1])
+      med = median(v, key, c)
       q = v[key, c - int(c / 4)]
       split(key, f, " ")
       printf "%-3s %-8s %12.4e %12.4e %12.4e\n", f[1], f[2], med, q, v[key, c]
@@ -71,13 +73,12 @@ sort -k1,1 -k2,2n -k3,3g "$log" | awk '
 # than the ratio of the medians, which mixes runs from different states of the host
 if [[ -s $pairs ]]; then
   echo "2-thread speed-up of each invocation (2 vs 1 threads): median, min-max, runs >= 1.8"
-  sort -k1,1 -k2,2g "$pairs" | awk '
+  sort -k1,1 -k2,2g "$pairs" | awk "$median"'
     { v[$1, ++n[$1]] = $2; if (!($1 in seen)) { seen[$1] = 1; keys[++nk] = $1 } if ($2 >= 1.8) ++hit[$1] }
     END {
       for (k = 1; k <= nk; ++k) {
         t = keys[k]; c = n[t]
-        med = (c % 2) ? v[t, (c + 1) / 2] : 0.5 * (v[t, c / 2] + v[t, c / 2 + 1])
-        printf "%-3s %12.3f   %.3f-%.3f   %d of %d\n", t, med, v[t, 1], v[t, c], hit[t] + 0, c
+        printf "%-3s %12.3f   %.3f-%.3f   %d of %d\n", t, median(v, t, c), v[t, 1], v[t, c], hit[t] + 0, c
       }
     }'
 fi
