@@ -13,7 +13,7 @@
 // bit-identical across the thread counts it measured (house style §12).
 //
 //   bench_dense [--threads 1,2] [--steps 20000] [--repeats 5] [--cache FILE] [--export-lammps FILE]
-//               [--no-energy] [--skin METRES] [--order file|morton] [--tile NX,NY,NZ]
+//               [--no-energy] [--skin METRES] [--order file|morton|shuffled] [--tile NX,NY,NZ]
 // --tile replicates the periodic packing NX x NY x NZ times (same density, stress and contacts per particle:
 // the scaling measurement of issue 6 uses 1,1,1 / 2,2,2 / 4,4,4 / 6,6,7 = 4k, 32k, 256k, 1M spheres).
 #include <algorithm>
@@ -39,6 +39,7 @@
 #include "core/gas_generator.hpp"
 #include "core/measurements.hpp"
 #include "core/packing_io.hpp"
+#include "core/rng.hpp"
 #include "core/simulation.hpp"
 #include "core/spatial_order.hpp"
 
@@ -58,13 +59,15 @@ struct Options {
   bool trackEnergy = true;
   double skin = 0.0;  // 0: the engine's default (0.1 x mean diameter)
   std::array<int, 3> tile{1, 1, 1};  // periodic replicas of the packing per axis
-  bool morton = true;  // particles in Z-order (core/spatial_order.hpp); false: the cached packing's order
+  // particle order: Z-order (core/spatial_order.hpp), the cached packing's, or a seeded random permutation
+  // (what a packing imported in arbitrary order would run at, were it not sorted)
+  enum class Order { Morton, File, Shuffled } order = Order::Morton;
 };
 
 [[noreturn]] void usage(const char* msg) {
   std::fprintf(stderr,
                "bench_dense: %s\nusage: bench_dense [--threads 1,2] [--steps N] [--repeats N] [--cache FILE]\n"
-               "                   [--export-lammps FILE] [--no-energy] [--skin METRES] [--order file|morton]\n"
+               "                   [--export-lammps FILE] [--no-energy] [--skin METRES] [--order file|morton|shuffled]\n"
                "                   [--tile NX,NY,NZ]\n",
                msg);
   std::exit(2);
@@ -105,8 +108,8 @@ Options parse(int argc, char** argv) {
       if (k2 != 3 || o.tile[0] < 1 || o.tile[1] < 1 || o.tile[2] < 1) usage("--tile takes three positive integers");
     } else if (a == "--order") {
       const std::string v = value();
-      if (v != "file" && v != "morton") usage("--order takes file or morton");
-      o.morton = v == "morton";
+      if (v != "file" && v != "morton" && v != "shuffled") usage("--order takes file, morton or shuffled");
+      o.order = v == "morton" ? Options::Order::Morton : v == "file" ? Options::Order::File : Options::Order::Shuffled;
     } else if (a == "-h" || a == "--help") {
       usage("help");
     } else {
@@ -212,7 +215,14 @@ Simulation measuredScene(const Simulation& prepared, int threads, const Options&
   PeriodicCell cell(H * Vec3(o.tile[0], o.tile[1], o.tile[2]).asDiagonal().toDenseMatrix());
   // Z-order: pair partners and their pair data mostly share a thread's half of the arrays (the LAMMPS data
   // file is written from this scene, so LAMMPS reads the same order; it re-sorts by itself every 1000 steps)
-  if (o.morton) sortSpatially(p, cell);
+  if (o.order == Options::Order::Morton) sortSpatially(p, cell);
+  if (o.order == Options::Order::Shuffled) {
+    std::vector<std::size_t> perm(p.size());
+    for (std::size_t k = 0; k < perm.size(); ++k) perm[k] = k;
+    Rng rng(12345);  // Fisher-Yates, the same permutation in every run
+    for (std::size_t k = perm.size(); k > 1; --k) std::swap(perm[k - 1], perm[rng.nextU64() % k]);
+    reorderParticles(p, perm);
+  }
   NumericsSettings num;
   num.timeStep = kDt;
   num.localDamping = 0.0;
@@ -272,7 +282,7 @@ int main(int argc, char** argv) {
                 counts.contacts, s0.contacts().size());
     std::printf("numerics: dt = %.3g s, skin = %.6g m, energy tracking %s, steps %ld, repeats %d, order %s\n",
                 s0.timeStep(), s0.skin(), o.trackEnergy ? "on" : "off", o.steps, o.repeats,
-                o.morton ? "morton" : "file");
+                o.order == Options::Order::Morton ? "morton" : o.order == Options::Order::File ? "file" : "shuffled");
     if (!o.exportLammps.empty()) {
       writeLammpsData(o.exportLammps, s0.particles(), s0.cell(), s0.materials());
       const Material& m = s0.materials().at(0);

@@ -103,7 +103,7 @@ std::vector<SchemaField> makeSchema() {
   s.push_back(list("specimen", "fractions", "-", "[1, 1, 1, 1, 1, 1, 1]", 0, kInf,
                    "Weights of the diameters (normalised); number or mass fractions per 'basis'."));
   s.push_back(choice("specimen", "basis", "number", {"number", "mass"}, "Whether 'fractions' count particles or mass."));
-  s.push_back(text("specimen", "path", "", "File for source checkpoint/csv/lammps, relative to the scene file."));
+  s.push_back(text("specimen", "path", "", "File for source checkpoint/csv/lammps, relative to the scene file. A csv/lammps packing is put in Z-order for speed; each particle keeps its file row (from 0) as id."));
   // numerics
   s.push_back(num("numerics", "time_step_factor", "-", "0.25", 0, 1, true, false,
                   "Time step as a fraction of the Rayleigh time step (used when time_step = 0)."));
