@@ -306,7 +306,7 @@ TEST(RunnerSpecimen, ImportedPackingsAreZOrderedAndKeepTheirFileRowsAsIds) {
     std::size_t unsorted = 0;
     for (std::size_t k = 0; k < order.size(); ++k) unsorted += order[k] != k;
     EXPECT_EQ(unsorted, 0u);
-    std::size_t kept = 0;  // particles whose file row (id) is not their index: the import was reordered
+    std::size_t kept = 0;  // particles still at their file row: few, since the import was reordered
     std::vector<int> seen(p.size(), 0);
     for (std::size_t k = 0; k < p.size(); ++k) {
       const auto row = static_cast<std::size_t>(p.id[k]);
