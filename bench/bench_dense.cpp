@@ -219,8 +219,8 @@ Simulation measuredScene(const Simulation& prepared, int threads, const Options&
   if (o.order == Options::Order::Shuffled) {
     std::vector<std::size_t> perm(p.size());
     for (std::size_t k = 0; k < perm.size(); ++k) perm[k] = k;
-    Rng rng(12345);  // Fisher-Yates, the same permutation in every run
-    for (std::size_t k = perm.size(); k > 1; --k) std::swap(perm[k - 1], perm[rng.nextU64() % k]);
+    Rng rng(12345);  // the same permutation in every run
+    shuffle(perm, rng);
     reorderParticles(p, perm);
   }
   NumericsSettings num;

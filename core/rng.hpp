@@ -3,7 +3,10 @@
 // so it is not used where results must be reproducible from a seed.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <utility>
+#include <vector>
 
 namespace fl {
 
@@ -27,5 +30,12 @@ class Rng {
  private:
   std::uint64_t m_state;
 };
+
+// Fisher–Yates shuffle driven by rng (std::shuffle's use of the generator is implementation-defined):
+// the same permutation for a seed on every platform.
+template <class T>
+void shuffle(std::vector<T>& a, Rng& rng) {
+  for (std::size_t i = a.size(); i > 1; --i) std::swap(a[i - 1], a[rng.nextU64() % i]);
+}
 
 }  // namespace fl

@@ -57,23 +57,23 @@ Runner::Runner(Scene scene) : m_scene(std::move(scene)) {
   const NumericsSettings num = resolvedNumerics(m_scene.numerics);
   const auto& spec = m_scene.specimen;
   switch (spec.source) {
-    case SpecimenSpec::Source::Gas: {
-      GasSpec g = spec.gas;
-      g.density = m_scene.material.density;
-      Packing pk = generateGas(g);
-      // Z-order the generated specimen (issue 6): pairs and the kick's gathers stay within a thread's half
-      // of the arrays and in cache. Physics is unchanged; each particle keeps its generation id.
-      sortSpatially(pk.particles, pk.cell);
-      m_sim = std::make_unique<Simulation>(std::move(pk.particles), pk.cell, std::vector<Material>{m_scene.material}, num);
-      break;
-    }
+    case SpecimenSpec::Source::Gas:
     case SpecimenSpec::Source::Csv:
     case SpecimenSpec::Source::Lammps: {
-      Packing pk = spec.source == SpecimenSpec::Source::Csv ? readPackingCsv(spec.path, m_scene.material.density, 0)
-                                                           : readLammpsData(spec.path, 0);
-      // Z-order an imported packing too: in an arbitrary order the step ran ~1.2x (1 thread) and ~1.3x (2)
-      // slower at 4000 spheres and ~2x slower at 256 000 (docs/performance.md, fifteenth session). Each
-      // particle keeps its file row as id, which the snapshots write.
+      Packing pk;
+      if (spec.source == SpecimenSpec::Source::Gas) {
+        GasSpec g = spec.gas;
+        g.density = m_scene.material.density;
+        pk = generateGas(g);
+      } else {
+        pk = spec.source == SpecimenSpec::Source::Csv ? readPackingCsv(spec.path, m_scene.material.density, 0)
+                                                      : readLammpsData(spec.path, 0);
+      }
+      // Z-order the specimen, generated or imported (issue 6): pairs and the kick's gathers stay within a
+      // thread's half of the arrays and in cache. An import in arbitrary order ran the step ~1.2x (1 thread)
+      // and ~1.3x (2) slower at 4000 spheres and ~2x slower at 256 000 (docs/performance.md, fifteenth
+      // session). Physics is unchanged; each particle keeps its id (generation index or file row), which the
+      // snapshots write.
       sortSpatially(pk.particles, pk.cell);
       m_sim = std::make_unique<Simulation>(std::move(pk.particles), pk.cell, std::vector<Material>{m_scene.material}, num);
       break;

@@ -68,7 +68,7 @@ std::vector<double> sampleRadii(const SizeDistribution& psd, int count, std::uin
   radii.reserve(count);
   for (std::size_t k = 0; k < K; ++k) radii.insert(radii.end(), n[k], 0.5 * psd.diameters[k]);
   Rng rng(seed);
-  for (std::size_t i = radii.size(); i > 1; --i) std::swap(radii[i - 1], radii[rng.nextU64() % i]);
+  shuffle(radii, rng);
   return radii;
 }
 
