@@ -14,6 +14,7 @@
 #include "contact_kernels.hpp"
 #include "mindlin_deresiewicz.hpp"
 #include "simulation.hpp"
+#include "streaming_store.hpp"
 
 namespace fl {
 
@@ -129,9 +130,10 @@ void Simulation::contactPassBlocked() {
       std::fill_n(b.friction, kernels::kBlockPairs, pp.friction);
       std::fill_n(b.dampingRatio, kernels::kBlockPairs, pp.dampingRatio);
     }
-    // the partners to prefetch: all of them when the state outgrows the caches (kPrefetchAllFrom), else those
+    // the partners to prefetch: all of them when the state outgrows the caches (kLargeStateFrom), else those
     // outside this thread's own particles (another core drifted them; none with one thread)
-    const bool all = arr.n >= kPrefetchAllFrom;
+    const bool all = arr.n >= kLargeStateFrom;
+    const bool stream = all;  // result lines by streaming stores (kLargeStateFrom)
     const bool remote = all || nt > 1;
     const bool own = nt == m_sharesThreads;
     const auto ownFrom = static_cast<std::uint32_t>(own ? m_particleShares[t] : staticBegin(t, nt, arr.n));
@@ -222,7 +224,13 @@ void Simulation::contactPassBlocked() {
           const std::size_t p = static_cast<std::size_t>(index[s]);
           arr.hist[p].tangentialForce = Vec3(b.tx[s], b.ty[s], b.tz[s]);
           arr.hist[p].contactRadius = b.aPrev[s];
-          arr.result[p] = {Vec3(b.fx[s], b.fy[s], b.fz[s]), Vec3(b.mx[s], b.my[s], b.mz[s]), b.delta[s], b.fn[s]};
+          if (stream) {
+            // the line in PairResult's order: force, moment, overlap, normal force
+            const double line[8] = {b.fx[s], b.fy[s], b.fz[s], b.mx[s], b.my[s], b.mz[s], b.delta[s], b.fn[s]};
+            streamLine(arr.result + p, line);
+          } else {
+            arr.result[p] = {Vec3(b.fx[s], b.fy[s], b.fz[s]), Vec3(b.mx[s], b.my[s], b.mz[s]), b.delta[s], b.fn[s]};
+          }
         }
         acc.contacts += static_cast<std::size_t>(m);
       }
@@ -235,6 +243,7 @@ void Simulation::contactPassBlocked() {
       }
       chunks[k] = acc;
     }
+    if (stream) streamFence();  // the kick's threads read these lines after the region's barrier
   }
   m_profile.stolenRuns += static_cast<long>(m_ranges.stolen());
   // the diagnostics' extremes and means and the elastic energies are read off the stored contacts on demand

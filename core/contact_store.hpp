@@ -59,6 +59,8 @@ struct alignas(64) PairResult {
   double overlap = 0.0;        // delta [m]; <= 0: not touching
   double normalForce = 0.0;    // F_n on j along n, elastic + damping, >= 0 [N]
 };
+// one line, eight doubles in this order: the contact pass may write it whole (streamLine, streaming_store.hpp)
+static_assert(sizeof(PairResult) == 64 && alignof(PairResult) == 64, "one aligned cache line per pair");
 
 struct ContactStore {
   // pair definition (rebuilt with the neighbour list)

@@ -324,7 +324,7 @@ void Simulation::kickPass() {
       2 * kChunk * (own ? m_chunkShares[thread] : staticBegin(thread, threads, passChunks)));
   const auto ownTo = static_cast<std::uint32_t>(std::min(
       2 * m_c.size(), 2 * kChunk * (own ? m_chunkShares[thread + 1] : staticBegin(thread + 1, threads, passChunks))));
-  const bool large = static_cast<std::size_t>(n) >= kPrefetchAllFrom;
+  const bool large = static_cast<std::size_t>(n) >= kLargeStateFrom;
   const bool fetch = large || threads > 1;
   const std::uint32_t ownSpan = large ? 0 : ownTo - ownFrom;  // every entry lies outside an empty span
   ThreadRuns runs(m_ranges, thread, threads, static_cast<std::size_t>(n));  // the particles this thread kicks, run by run

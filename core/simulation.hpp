@@ -65,6 +65,15 @@ struct ContactDiagnostics {
 
 class Simulation {
  public:
+  // From this many particles (~7.6 MB of state at ~760 bytes each) the state outgrows the caches, and the step
+  // reads its lines as it would from memory:
+  // - software prefetches pay for every line, not only those the other core last wrote: the contact pass
+  //   prefetches every partner and the kick every result line (with one thread, 32 000 spheres (24 MB) ran
+  //   3.2e6 particle-steps/s without and 4.5e6 with the partners' prefetch, 4000 spheres (3 MB) ~15 % faster
+  //   without; Zen 3, docs/performance.md);
+  // - the contact pass writes its result lines with streaming stores (core/streaming_store.hpp): 256 000 and
+  //   1M spheres 4-14 % faster on an Intel host, 32 000 level (docs/performance.md, sixteenth session).
+  static constexpr std::size_t kLargeStateFrom = 10000;
   Simulation(ParticleStore particles, PeriodicCell cell, std::vector<Material> materials,
              NumericsSettings numerics);
   ~Simulation();
@@ -210,12 +219,6 @@ class Simulation {
   // Fixed reduction block (pairs or particles): results are independent of the thread count. Small enough
   // that 2 threads share ~60 blocks of a 4000-sphere packing evenly, large enough to amortise a block's sums.
   static constexpr std::size_t kChunk = 256;
-  // Software prefetches pay for lines that are not in cache: those the other core last wrote, and all of them
-  // once the state outgrows the caches. From this many particles (~7.6 MB of state at ~760 bytes each) the
-  // contact pass prefetches every partner and the kick every result line: with one thread, 32 000 spheres
-  // (24 MB) ran 3.2e6 particle-steps/s without and 4.5e6 with the partners' prefetch, 4000 spheres (3 MB)
-  // ~15 % faster without (Zen 3, docs/performance.md).
-  static constexpr std::size_t kPrefetchAllFrom = 10000;
   // How far ahead (particles) the drift prefetches the lines it will write: lines last read by the other
   // core arrive ~200 ns late on this kind of VM, ~25 particles' work at ~8 ns each (docs/performance.md,
   // "per-thread busy time": 4 ahead left the second thread's drift 50 % slower than the first's). Only the
@@ -226,7 +229,7 @@ class Simulation {
   // the dense packing's ~8.7 listed pairs each, ~200 ns of the kick's work (35 entries left the second
   // thread, which gathers the results the first wrote across the boundary, 20 % slower). Only the lines of
   // pairs outside the thread's own share of the pass (another core most likely wrote them), or all from
-  // kPrefetchAllFrom particles: with one thread at 4000 spheres, prefetching every entry cost 2-7 % of a step.
+  // kLargeStateFrom particles: with one thread at 4000 spheres, prefetching every entry cost 2-7 % of a step.
   static constexpr int kPrefetchEntries = 140;
   // Partial sums of one fixed block of pairs (or particles), reduced in block order.
   struct Chunk {

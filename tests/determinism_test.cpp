@@ -2,41 +2,16 @@
 // thread computed what.
 #include <gtest/gtest.h>
 
-#include <cstring>
-
 #include "core/simulation.hpp"
 #include "test_support.hpp"
 
 using namespace fl;
 
-namespace {
-Simulation compressed(int threads, double localDamping = 0.05, double restitution = 0.5, bool trackEnergy = true) {
-  Packing pk = test::stirredGas(1500, 0.35, 11, 3);
-  NumericsSettings num;
-  num.threads = threads;
-  num.restitution = restitution;
-  num.trackEnergy = trackEnergy;
-  num.localDamping = localDamping;
-  Simulation sim(std::move(pk.particles), pk.cell, {Material::paperGlass()}, num);
-  Mat3 L = Mat3::Zero();
-  L.diagonal() = Vec3(-400, -400, -500);
-  sim.setVelocityGradient(L);
-  return sim;
-}
-
-void expectSameBits(const Simulation& a, const Simulation& b) {
-  EXPECT_TRUE(test::sameBits(a.particles().pos, b.particles().pos));
-  EXPECT_TRUE(test::sameBits(a.particles().vel, b.particles().vel));
-  EXPECT_TRUE(test::sameBits(a.particles().angVel, b.particles().angVel));
-  EXPECT_TRUE(test::sameBits(a.particles().force, b.particles().force));
-  EXPECT_TRUE(test::sameBits(a.contacts().history, b.contacts().history));
-  EXPECT_EQ(std::memcmp(a.contactStress().data(), b.contactStress().data(), sizeof(Mat3)), 0);
-}
-
-}  // namespace
+using test::compressingGas;
+using test::expectSameBits;
 
 TEST(Determinism, OneAndTwoThreadsGiveIdenticalBits) {
-  Simulation a = compressed(1), b = compressed(2);
+  Simulation a = compressingGas(1), b = compressingGas(2);
   a.run(4000);
   b.run(4000);
   ASSERT_GT(a.contacts().activeCount(), 1000u) << "the test must exercise many contacts";
@@ -48,13 +23,13 @@ TEST(Determinism, OneAndTwoThreadsGiveIdenticalBits) {
 // The common case of the cyclic stages (no local damping, no contact damping, no energy terms in the law's
 // block): 1 to 4 threads, where 3 and 4 split the chunks unevenly.
 TEST(Determinism, WithoutDampingOneToFourThreadsGiveIdenticalBits) {
-  Simulation a = compressed(1, 0.0, 1.0, false);
+  Simulation a = compressingGas(1, 0.0, 1.0, false);
   a.run(4000);
   ASSERT_GT(a.contacts().activeCount(), 1000u) << "the test must exercise many contacts";
   ASSERT_GT(a.profile().rebuilds, 2);
   for (int threads : {2, 3, 4}) {
     SCOPED_TRACE(threads);
-    Simulation b = compressed(threads, 0.0, 1.0, false);
+    Simulation b = compressingGas(threads, 0.0, 1.0, false);
     b.run(4000);
     expectSameBits(a, b);
   }
@@ -64,12 +39,12 @@ TEST(Determinism, WithoutDampingOneToFourThreadsGiveIdenticalBits) {
 // 1, 2 and 3 threads: the dissipated works are summed per fixed chunk of pairs or particles, in chunk order,
 // whichever thread computed a chunk (3 threads split the 16 particle chunks and the pair chunks unevenly).
 TEST(Determinism, LocalDampingWorkHasTheSameBitsForOneToThreeThreads) {
-  Simulation a = compressed(1);
+  Simulation a = compressingGas(1);
   a.run(3000);
   ASSERT_GT(a.energy().localDampingWork, 0.0) << "the test must exercise the local damping";
   for (int threads : {2, 3}) {
     SCOPED_TRACE(threads);
-    Simulation b = compressed(threads);
+    Simulation b = compressingGas(threads);
     b.run(3000);
     expectSameBits(a, b);
     const EnergyLedger& ea = a.energy();
@@ -86,9 +61,9 @@ TEST(Determinism, LocalDampingWorkHasTheSameBitsForOneToThreeThreads) {
 // computes a pair or moves a particle changes from step to step. Eight threads on this test's cores leave some
 // of them waiting for a core, and the others take their runs: the bits are still those of one thread.
 TEST(Determinism, RunsTakenFromAnotherThreadGiveTheSameBits) {
-  Simulation a = compressed(1, 0.0, 1.0, false);
+  Simulation a = compressingGas(1, 0.0, 1.0, false);
   a.run(4000);
-  Simulation b = compressed(8, 0.0, 1.0, false);
+  Simulation b = compressingGas(8, 0.0, 1.0, false);
   b.run(4000);
   ASSERT_GT(a.contacts().activeCount(), 1000u) << "the test must exercise many contacts";
   EXPECT_EQ(a.profile().stolenRuns, 0) << "one thread takes its whole share";
