@@ -412,18 +412,14 @@ TEST(MindlinDeresiewiczScene, SelectedByNameRunsAndRejectsUnknownNames) {
 }
 
 namespace {
+// The shared compressing gas with the given tangential law, threads and restitution.
 Simulation compressedGas(int count, TangentialModel model, int threads, double restitution) {
-  Packing pk = test::stirredGas(count, 0.35, 11, 3);
   NumericsSettings num;
   num.threads = threads;
   num.restitution = restitution;
   num.localDamping = 0.05;
   num.tangentialModel = model;
-  Simulation sim(std::move(pk.particles), pk.cell, {Material::paperGlass()}, num);
-  Mat3 L = Mat3::Zero();
-  L.diagonal() = Vec3(-400, -400, -500);
-  sim.setVelocityGradient(L);
-  return sim;
+  return test::compressingGasWith(count, num);
 }
 }  // namespace
 
