@@ -92,11 +92,16 @@ void Simulation::syncTangentialHistory() {
 
 template <bool kEnergy, bool kDamping, bool kAffine, bool kMD>
 void Simulation::contactPass() {
-  if constexpr (kMD) contactPassMindlinDeresiewicz<kEnergy, kDamping, kAffine>();
-  else contactPassBlocked<kEnergy, kDamping, kAffine>();
+  if constexpr (kMD) {
+    contactPassMindlinDeresiewicz<kEnergy, kDamping, kAffine>();
+  } else {
+    updateShares();
+    if (m_boundary.exchange) contactPassBlocked<kEnergy, kDamping, kAffine, true>();
+    else contactPassBlocked<kEnergy, kDamping, kAffine, false>();
+  }
 }
 
-template <bool kEnergy, bool kDamping, bool kAffine>
+template <bool kEnergy, bool kDamping, bool kAffine, bool kHalo>
 void Simulation::contactPassBlocked() {
   // Three phases per block of listed pairs, all within one reduction chunk (so the bits do not depend on
   // the thread count): 1. gather the touching pairs' inputs into a PairBlock (branch-free compaction);
@@ -111,13 +116,40 @@ void Simulation::contactPassBlocked() {
   const PassParticle* pass = arr.pp;
   const PairTable& table = m_pairs;
   Chunk* chunks = m_chunks.data();
-  const std::int32_t* partner = arr.second;
   const Vec3* omega = arr.w;
   updateShares();
   m_ranges.reset(m_chunkShares, 1);
+  const ThreadBoundary& tb = m_boundary;
+  PassParticle* haloPass = m_haloPass.data();
+  Vec3* haloW = m_haloW.data();
+  KickSeed* seeds = m_seeds.data();
+  const auto n = static_cast<std::int32_t>(arr.n);
+  int team = 0;
 #pragma omp parallel num_threads(m_num.threads)
   {
     const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+    if (t == 0) team = nt;
+    // with the boundary of this team: each owner first copies the partners other threads read into the halo
+    // (thread_boundary.hpp), and the pass reads them there, whichever thread computes the pair
+    const bool exchange = kHalo && nt == tb.threads && tb.exchange;
+    if (exchange) {
+      for (std::size_t q = tb.haloBegin[t]; q < tb.haloBegin[t + 1]; ++q) {
+        const std::int32_t j = tb.halo[q];
+        haloPass[q] = pass[j];
+        haloW[q] = omega[j];
+      }
+#pragma omp barrier
+    }
+    const std::int32_t* partner = exchange ? tb.partner.data() : arr.second;
+    // a partner index past the particle count is a halo slot (kHalo only: one thread pays no select)
+    const auto passOf = [pass, haloPass, n](std::int32_t jn) -> const PassParticle& {
+      if constexpr (kHalo) return jn < n ? pass[jn] : haloPass[jn - n];
+      return pass[jn];
+    };
+    const auto omegaOf = [omega, haloW, n](std::int32_t jn) -> const Vec3& {
+      if constexpr (kHalo) return jn < n ? omega[jn] : haloW[jn - n];
+      return omega[jn];
+    };
     kernels::PairBlock b{};  // per thread, ~23 KiB: stays in L1 through the three phases
     std::int32_t index[kernels::kBlockPairs];  // pair of each slot
     // one material (the paper's scenes): every pair has the same parameters, written into all the block's
@@ -154,9 +186,9 @@ void Simulation::contactPassBlocked() {
         if (remote)
           for (std::size_t q = p1, qEnd = std::min(np, p1 + kernels::kBlockPairs); q < qEnd; ++q) {
             const std::int32_t jn = partner[q];
-            if (static_cast<std::uint32_t>(jn) - ownFrom >= ownSpan) {
-              __builtin_prefetch(pass + jn);
-              __builtin_prefetch(omega + jn);
+            if (static_cast<std::uint32_t>(jn) - ownFrom >= ownSpan) {  // a halo slot lies outside too
+              __builtin_prefetch(&passOf(jn));
+              __builtin_prefetch(&omegaOf(jn));
             }
           }
         // 1a. geometry of every listed pair: each is written to slot m, which advances only for a touching
@@ -166,7 +198,7 @@ void Simulation::contactPassBlocked() {
         std::uint64_t touchingNow = 0;
         for (std::size_t p = p0; p < p1; ++p) {
           const int i = arr.first[p];
-          const PassParticle& pj = pass[partner[p]];
+          const PassParticle& pj = passOf(partner[p]);
           Vec3 d = pj.x - pass[i].x;  // l = x_j + H image - x_i
           const Image img = arr.image[p];
           if (!img.isZero()) d += arr.cell.shift(img.vec());
@@ -186,8 +218,8 @@ void Simulation::contactPassBlocked() {
           const std::size_t p = static_cast<std::size_t>(index[s]);
           const int i = arr.first[p];
           const std::int32_t jn = partner[p];
-          const PassParticle& pj = pass[jn];
-          const Vec3& wj = omega[jn];
+          const PassParticle& pj = passOf(jn);
+          const Vec3& wj = omegaOf(jn);
           // relative velocity of the centres, with the mean field L·d, which carries the image shift
           // velocity L·H·n for pairs across the boundary (verification ladder §2)
           Vec3 vr = pj.v - pass[i].v;
@@ -244,7 +276,23 @@ void Simulation::contactPassBlocked() {
       chunks[k] = acc;
     }
     if (stream) streamFence();  // the kick's threads read these lines after the region's barrier
+    // the seeds this thread owes: the leading adjacency entries of other threads' particles that its share of
+    // the chunks holds, summed once every thread is done (a run of that share may have been stolen)
+    if (exchange) {
+#pragma omp barrier
+      for (std::size_t q = tb.seedBegin[t]; q < tb.seedBegin[t + 1]; ++q) {
+        const std::int32_t i = tb.seedParticle[q];
+        const double ri = m_p.radius[i];  // not pass[i]: its owner's line
+        double fx = 0.0, fy = 0.0, fz = 0.0, tx = 0.0, ty = 0.0, tz = 0.0;
+        for (std::int32_t e = m_c.adjStart[i]; e < tb.kickBegin[i]; ++e) {
+          const std::int32_t entry = m_c.adjEntry[e];
+          kickEntry(arr.result[entry >> 1], entry, ri, fx, fy, fz, tx, ty, tz);
+        }
+        seeds[q] = {fx, fy, fz, tx, ty, tz};
+      }
+    }
   }
+  m_seedsReady = kHalo && team == tb.threads && tb.exchange;
   m_profile.stolenRuns += static_cast<long>(m_ranges.stolen());
   // the diagnostics' extremes and means and the elastic energies are read off the stored contacts on demand
   reduceContactChunks<kEnergy, false>(nchunks);
@@ -253,6 +301,7 @@ void Simulation::contactPassBlocked() {
 template <bool kEnergy, bool kDamping, bool kAffine>
 void Simulation::contactPassMindlinDeresiewicz() {
   m_c.touchedValid = false;  // this pass changes the history without ContactStore::touched
+  m_seedsReady = false;      // nor does it sum the seeds: the kick reads every entry
   const PassArrays arr(m_pass, m_p, m_c, m_cell, m_dt);
   const std::size_t np = arr.np, nchunks = arr.chunks(kChunk);
   const PassParticle* pass = arr.pp;

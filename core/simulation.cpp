@@ -19,24 +19,6 @@ double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock:
 // -1, 0 or +1: the direction Cundall's local damping opposes (drift and kick)
 inline double signOf(double x) { return x > 0 ? 1.0 : (x < 0 ? -1.0 : 0.0); }
 
-// the sign of a pair's force on its first (side 0) and second (side 1) particle: a load, where computing it
-// from the side bit took four operations of the kick's ~20 an entry
-constexpr double kSideSign[2] = {-1.0, 1.0};
-
-// One adjacency entry (pair << 1 | side) of a particle of radius ri added to its force and torque sums. Side 1
-// (second particle) receives +f, side 0 -f; the torque is -(r_self - delta/2) n x f on both (contact point on the
-// pair axis). Written as explicit std::fma, with the same bits, it made the 1-thread kick 10 % slower.
-inline void kickEntry(const PairResult& c, std::int32_t entry, double ri, double& fx, double& fy, double& fz,
-                      double& tx, double& ty, double& tz) {
-  const double sign = kSideSign[entry & 1];
-  const double arm = ri - 0.5 * c.overlap;
-  tx -= arm * c.moment.x();
-  ty -= arm * c.moment.y();
-  tz -= arm * c.moment.z();
-  fx += sign * c.force.x();
-  fy += sign * c.force.y();
-  fz += sign * c.force.z();
-}
 }  // namespace
 
 const char* stageName(Stage s) {
@@ -264,23 +246,22 @@ void Simulation::packPassParticles() {
 void Simulation::resizeChunks() {
   m_chunks.resize(std::max<std::size_t>(1, (std::max(m_c.size(), m_p.size()) + kChunk - 1) / kChunk));
   m_sharesThreads = 0;  // the pairs changed: the shares are made again at their first use
+  m_seedsReady = false;
 }
 
 void Simulation::updateShares() {
   const int nt = std::max(1, m_num.threads);
   if (m_sharesThreads == nt) return;
-  const std::size_t n = m_p.size(), np = m_c.size(), chunks = (np + kChunk - 1) / kChunk;
-  m_chunkShares.resize(nt + 1);
-  m_particleShares.resize(nt + 1);
-  for (int t = 0; t <= nt; ++t) m_chunkShares[t] = staticBegin(t, nt, chunks);
   // each thread's particles start at the first particle of its first chunk's pairs (pairs are sorted by their
-  // first particle); without a chunk each, the particles are split statically
-  const bool aligned = chunks >= static_cast<std::size_t>(nt);
-  for (int t = 0; t <= nt; ++t)
-    m_particleShares[t] = t == nt ? n
-                          : !aligned ? staticBegin(t, nt, n)
-                          : t == 0   ? 0
-                                     : static_cast<std::size_t>(m_c.first[kChunk * m_chunkShares[t]]);
+  // first particle); without a chunk each, the particles are split statically and nothing is exchanged; the
+  // halo and seeds only while the state stays in cache (kLargeStateFrom)
+  m_boundary = buildThreadBoundary(m_c, m_p.size(), nt, kChunk, m_p.size() < kLargeStateFrom);
+  m_chunkShares = m_boundary.chunkBegin;
+  m_particleShares = m_boundary.begin;
+  m_haloPass.resize(m_boundary.halo.size());
+  m_haloW.resize(m_boundary.halo.size());
+  m_seeds.assign(m_boundary.seedParticle.size(), KickSeed{});
+  m_seedsReady = false;
   m_sharesThreads = nt;
 }
 
@@ -288,11 +269,13 @@ void Simulation::updateShares() {
 
 // ---- 4. kick ------------------------------------------------------------------------------------
 void Simulation::kick() {
-  if (m_num.localDamping > 0.0) kickPass<true>();
-  else kickPass<false>();
+  // seeds only after a pass that summed them (thread_boundary.hpp); one thread never has any
+  const bool seeds = m_seedsReady;
+  if (m_num.localDamping > 0.0) seeds ? kickPass<true, true>() : kickPass<true, false>();
+  else seeds ? kickPass<false, true>() : kickPass<false, false>();
 }
 
-template <bool kLocalDamping>
+template <bool kLocalDamping, bool kSeeded>
 void Simulation::kickPass() {
   const int n = static_cast<int>(m_p.size());
   const std::size_t nchunks = (static_cast<std::size_t>(n) + kChunk - 1) / kChunk;
@@ -313,11 +296,21 @@ void Simulation::kickPass() {
   double* kickWork = m_kickWork.data();
   updateShares();
   m_ranges.reset(m_particleShares, kParticleGrain);
+  const ThreadBoundary& tb = m_boundary;
+  const KickSeed* seeds = m_seeds.data();
+  const bool seedsReady = m_seedsReady;
+  m_seedsReady = false;
 #pragma omp parallel num_threads(m_num.threads)
   {
   const int thread = omp_get_thread_num(), threads = omp_get_num_threads();
+  // the seeds of the last pass hold the leading entries another thread computed, whichever thread kicks the
+  // particle; without them (another team size, the Mindlin–Deresiewicz pass) every entry is read in place
+  const bool seeded = kSeeded && seedsReady && threads == tb.threads;
+  const std::int32_t* kickBegin = tb.kickBegin.data();
+  const std::int32_t* seedOf = tb.seedOf.data();
   // result lines to prefetch (kPrefetchEntries): all when the state outgrows the caches, else those of the pairs
-  // outside this thread's own share of the pass, which another thread most likely computed
+  // outside this thread's own share of the pass, which another thread most likely computed (with the seeds,
+  // none: they carry those entries)
   const bool own = threads == m_sharesThreads;
   const std::size_t passChunks = (m_c.size() + kChunk - 1) / kChunk;
   const auto ownFrom = static_cast<std::uint32_t>(
@@ -325,7 +318,7 @@ void Simulation::kickPass() {
   const auto ownTo = static_cast<std::uint32_t>(std::min(
       2 * m_c.size(), 2 * kChunk * (own ? m_chunkShares[thread + 1] : staticBegin(thread + 1, threads, passChunks))));
   const bool large = static_cast<std::size_t>(n) >= kLargeStateFrom;
-  const bool fetch = large || threads > 1;
+  const bool fetch = large || (threads > 1 && !seeded);
   const std::uint32_t ownSpan = large ? 0 : ownTo - ownFrom;  // every entry lies outside an empty span
   ThreadRuns runs(m_ranges, thread, threads, static_cast<std::size_t>(n));  // the particles this thread kicks, run by run
   for (std::size_t begin, end; runs.next(begin, end);)
@@ -336,7 +329,11 @@ void Simulation::kickPass() {
     // store-forwarding stall on the loop-carried torque (kick 5x slower).
     const double ri = rad[i];
     double fx = 0.0, fy = 0.0, fz = 0.0, tx = 0.0, ty = 0.0, tz = 0.0;
-    for (int e = adjStart[i]; e < adjStart[i + 1]; ++e) {
+    if (kSeeded && seeded) {  // slot 0: zero
+      const KickSeed& s0 = seeds[seedOf[i]];
+      fx = s0.fx, fy = s0.fy, fz = s0.fz, tx = s0.tx, ty = s0.ty, tz = s0.tz;
+    }
+    for (int e = kSeeded && seeded ? kickBegin[i] : adjStart[i]; e < adjStart[i + 1]; ++e) {
       // the result line kPrefetchEntries entries ahead (about 16 particles), if it is not in this core's cache
       if (fetch && e + kPrefetchEntries < entries) {
         const auto ahead = static_cast<std::uint32_t>(adjEntry[e + kPrefetchEntries]);
@@ -385,7 +382,9 @@ std::size_t Simulation::memoryBytes() const {
   return b(p.pos) + b(p.vel) + b(p.angVel) + b(p.force) + b(p.torque) + b(p.radius) + b(p.invMass) +
          b(p.invInertia) + b(p.id) + b(p.material) + b(p.image) + b(c.first) + b(c.second) + b(c.image) +
          b(c.history) + b(c.mdHistory) + b(c.result) + b(c.adjStart) + b(c.adjEntry) + b(m_refPos) +
-         b(m_pass) + b(m_chunks) + b(m_kickWork);
+         b(m_pass) + b(m_chunks) + b(m_kickWork) + b(m_haloPass) + b(m_haloW) + b(m_seeds) +
+         b(m_boundary.partner) + b(m_boundary.halo) + b(m_boundary.seedParticle) + b(m_boundary.seedOf) +
+         b(m_boundary.kickBegin);
 }
 
 // ---- measures -----------------------------------------------------------------------------------

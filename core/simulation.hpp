@@ -12,7 +12,9 @@
 //   5. control    the cell controller (if any) sets L for the next step
 // Deterministic: every reduction is over fixed-size chunks summed in chunk order, and forces are gathered
 // per particle from the CSR adjacency, so the bits do not depend on the thread count, nor on which thread
-// computed what: the parallel loops balance their work between the threads as they go (work_stealing.hpp).
+// computed what: the parallel loops balance their work between the threads as they go (work_stealing.hpp),
+// and while the state fits in cache the partners and force sums that cross the threads' shares go through a
+// halo and seeds (thread_boundary.hpp): copies and the kick's own partial sums.
 // Stress sign: compression positive (soil mechanics), sigma = (1/V) sum_c f_c (x) l_c with f_c the force
 // on j and l_c the branch vector from i to j.
 #pragma once
@@ -30,6 +32,7 @@
 #include "numerics.hpp"
 #include "particle_store.hpp"
 #include "periodic_cell.hpp"
+#include "thread_boundary.hpp"
 #include "work_stealing.hpp"
 
 namespace fl {
@@ -120,6 +123,8 @@ class Simulation {
   // contacts (or the pass summed them itself): a step that nobody measured leaves it false
   bool contactsMeasured() const { return m_contactsMeasured; }
   const StageProfile& profile() const { return m_profile; }
+  // The threads' shares and what crosses between them, as the last parallel step made them (thread_boundary.hpp)
+  const ThreadBoundary& threadBoundary() const { return m_boundary; }
   // Heap bytes held by the state (particle and pair arrays by capacity, history, adjacency, reduction
   // chunks); the neighbour grid is a temporary of each rebuild and not counted.
   std::size_t memoryBytes() const;
@@ -167,7 +172,9 @@ class Simulation {
   template <bool kEnergy, bool kDamping, bool kAffine, bool kMindlinDeresiewicz>
   void contactPass();  // selects one of the two below
   // Default law: pairs gathered into blocks of touching pairs, law vectorised across them (contact_block.hpp).
-  template <bool kEnergy, bool kDamping, bool kAffine>
+  // kHalo: the partners of other threads' shares are read from the halo and the seeds are summed
+  // (thread_boundary.hpp); one thread pays no select
+  template <bool kEnergy, bool kDamping, bool kAffine, bool kHalo>
   void contactPassBlocked();
   // Mindlin–Deresiewicz law: one pair at a time (its branch history does not vectorise).
   template <bool kEnergy, bool kDamping, bool kAffine>
@@ -184,12 +191,13 @@ class Simulation {
   // switching to it, fresh histories start from the stored normal forces).
   void syncTangentialHistory();
   void kick();
-  template <bool kLocalDamping>
-  void kickPass();
+  template <bool kLocalDamping, bool kSeeded>
+  void kickPass();  // kSeeded: the last pass summed the seeds of this team
   // The threads' own shares of the pair chunks (a static split) and of the particles (each thread's starting
   // where the pairs of its first chunk start, so that it drifts and kicks the particles whose pairs it computes
-  // as first particle), for m_num.threads; made again after each rebuild or restore and when the thread count
-  // changes. The parallel loops start from them and balance from there (work_stealing.hpp).
+  // as first particle), with the halo and seeds between them (thread_boundary.hpp), for m_num.threads; made
+  // again after each rebuild or restore and when the thread count changes. The parallel loops start from them
+  // and balance from there (work_stealing.hpp).
   void updateShares();
 
   ParticleStore m_p;
@@ -251,6 +259,11 @@ class Simulation {
   std::vector<std::size_t> m_chunkShares, m_particleShares;  // threads + 1 bounds each (updateShares)
   int m_sharesThreads = 0;  // the team size the shares are for; 0: to be made
   StealingRanges m_ranges;  // the claims of the current parallel loop
+  ThreadBoundary m_boundary;  // made with the shares (updateShares)
+  std::vector<PassParticle> m_haloPass;  // halo slots: the pass copy and omega of other threads' partners
+  std::vector<Vec3> m_haloW;
+  std::vector<KickSeed> m_seeds;  // slot 0 stays zero
+  bool m_seedsReady = false;      // the last pass summed the seeds for this team
 };
 
 }  // namespace fl

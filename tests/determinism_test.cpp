@@ -68,5 +68,9 @@ TEST(Determinism, RunsTakenFromAnotherThreadGiveTheSameBits) {
   ASSERT_GT(a.contacts().activeCount(), 1000u) << "the test must exercise many contacts";
   EXPECT_EQ(a.profile().stolenRuns, 0) << "one thread takes its whole share";
   EXPECT_GT(b.profile().stolenRuns, 0) << "the test must exercise runs taken from another thread";
+  // and the halo and seeds (core/thread_boundary.hpp), which a stolen run reads and writes too
+  EXPECT_TRUE(b.threadBoundary().exchange);
+  EXPECT_GT(b.threadBoundary().halo.size(), 0u);
+  EXPECT_GT(b.threadBoundary().seedParticle.size(), 1u);
   expectSameBits(a, b);
 }

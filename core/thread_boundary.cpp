@@ -1,0 +1,90 @@
+// The threads' shares and what crosses between them (thread_boundary.hpp).
+#include "thread_boundary.hpp"
+
+#include <algorithm>
+
+namespace fl {
+
+ThreadBoundary buildThreadBoundary(const ContactStore& c, std::size_t particleCount, int threads,
+                                   std::size_t chunk, bool halo) {
+  ThreadBoundary b;
+  const int nt = std::max(1, threads);
+  const std::size_t n = particleCount, np = c.size();
+  const std::size_t chunks = (np + chunk - 1) / chunk;
+  b.threads = nt;
+  b.begin.resize(nt + 1);
+  b.chunkBegin.resize(nt + 1);
+  for (int t = 0; t <= nt; ++t) b.chunkBegin[t] = staticBegin(t, nt, chunks);
+  const bool aligned = nt > 1 && chunks >= static_cast<std::size_t>(nt);
+  const bool exchange = aligned && halo;
+  for (int t = 0; t <= nt; ++t)
+    b.begin[t] = t == nt ? n
+                 : !aligned ? staticBegin(t, nt, n)
+                 : t == 0 ? 0
+                          : static_cast<std::size_t>(c.first[chunk * b.chunkBegin[t]]);
+  b.haloBegin.assign(nt + 1, 0);
+  b.seedBegin.assign(nt + 1, 1);
+  b.seedParticle.assign(1, -1);
+  b.exchange = exchange;
+  if (!exchange) return b;
+  b.partner.assign(c.second.begin(), c.second.end());
+  b.seedOf.assign(n, 0);
+  b.kickBegin.assign(c.adjStart.begin(), c.adjStart.begin() + static_cast<std::ptrdiff_t>(n));
+
+  std::vector<int> owner(n);
+  for (int t = 0; t < nt; ++t)
+    for (std::size_t i = b.begin[t]; i < b.begin[t + 1]; ++i) owner[i] = t;
+  std::vector<int> passThread(chunks);
+  for (int t = 0; t < nt; ++t)
+    for (std::size_t k = b.chunkBegin[t]; k < b.chunkBegin[t + 1]; ++k) passThread[k] = t;
+  const auto computedBy = [&](std::size_t p) { return passThread[p / chunk]; };
+
+  // halo: the second particles that a pair's pass thread does not own (a first particle another thread owns
+  // is read in place: only the first particle of a share can be one, for a few pairs)
+  std::vector<char> inHalo(n, 0);
+  for (std::size_t p = 0; p < np; ++p) {
+    const int j = c.second[p];
+    if (owner[j] != computedBy(p)) inHalo[j] = 1;
+  }
+  std::vector<std::int32_t> slot(n, -1);
+  for (std::size_t j = 0; j < n; ++j)
+    if (inHalo[j]) {
+      slot[j] = static_cast<std::int32_t>(b.halo.size());
+      b.halo.push_back(static_cast<std::int32_t>(j));
+      ++b.haloBegin[owner[j] + 1];
+    }
+  for (int t = 0; t < nt; ++t) b.haloBegin[t + 1] += b.haloBegin[t];
+  for (std::size_t p = 0; p < np; ++p) {
+    const int j = c.second[p];
+    if (owner[j] != computedBy(p)) b.partner[p] = static_cast<std::int32_t>(n) + slot[j];
+  }
+
+  // seeds: a particle whose leading adjacency entries were all computed by one other thread (entries are in
+  // pair order, and a share's pairs come after those of the shares before it, so the foreign ones lead)
+  std::vector<std::vector<std::int32_t>> seeds(nt);
+  for (std::size_t i = 0; i < n; ++i) {
+    const int self = owner[i];
+    const std::int32_t e0 = c.adjStart[i], e1 = c.adjStart[i + 1];
+    std::int32_t e = e0;
+    const int by = e < e1 ? computedBy(static_cast<std::size_t>(c.adjEntry[e] >> 1)) : self;
+    if (by == self) continue;
+    while (e < e1 && computedBy(static_cast<std::size_t>(c.adjEntry[e] >> 1)) == by) ++e;
+    bool foreignLater = false;  // another foreign entry after the run: leave the particle to read them all
+    for (std::int32_t q = e; q < e1; ++q)
+      foreignLater |= computedBy(static_cast<std::size_t>(c.adjEntry[q] >> 1)) != self;
+    if (foreignLater) continue;
+    seeds[by].push_back(static_cast<std::int32_t>(i));
+    b.kickBegin[i] = e;
+  }
+  for (int t = 0; t < nt; ++t) {
+    b.seedBegin[t] = b.seedParticle.size();
+    for (const std::int32_t i : seeds[t]) {
+      b.seedOf[i] = static_cast<std::int32_t>(b.seedParticle.size());
+      b.seedParticle.push_back(i);
+    }
+  }
+  b.seedBegin[nt] = b.seedParticle.size();
+  return b;
+}
+
+}  // namespace fl
