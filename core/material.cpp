@@ -33,7 +33,9 @@ double hertzTsujiRestitution(double beta) {
 }  // namespace
 
 double dampingRatioFromRestitution(double e) {
-  if (!(e > 0.0 && e <= 1.0)) throw InputError("restitution must be in (0, 1], got " + std::to_string(e));
+  if (!(e >= kMinRestitution && e <= 1.0))
+    throw InputError("restitution must be in [0.01, 1], got " + std::to_string(e));
+  static_assert(kMinRestitution == 0.01, "the message names the bound");
   if (e == 1.0) return 0.0;
   // The linear-spring formula beta = -ln e / sqrt(ln^2 e + pi^2) is only approximate for Hertz contacts
   // (e = 0.5 would come out near 0.55), so beta is found by bisection on the exact Hertz-Tsuji restitution.

@@ -31,8 +31,14 @@ struct PairParams {
   double dampingRatio = 0.0;  // -beta: Tsuji form, 0 = no contact damping, from restitution e [-]
 };
 
+// The smallest restitution the contact damping accepts. Below it the Tsuji damping ratio grows without bound
+// (e = 0.01 needs beta = 4.8, about 4.4 times critical damping; e = 1e-4 needs 50), the explicit step is no
+// longer stable with it, and finding beta took seconds to minutes (a fuzzed checkpoint with e near 1e-300 ran
+// the search for longer than the fuzzer's 15 s limit).
+constexpr double kMinRestitution = 0.01;
+
 // Damping ratio beta of the Tsuji et al. (1992) Hertzian viscoelastic damping that gives the
-// restitution coefficient e in (0, 1] exactly (speed-independent for Hertz; found numerically).
+// restitution coefficient e in [kMinRestitution, 1] exactly (speed-independent for Hertz; found numerically).
 double dampingRatioFromRestitution(double restitution);
 
 class PairTable {

@@ -15,7 +15,7 @@ void NumericsSettings::validate() const {
   if (!(timeStepFactor > 0.0 && timeStepFactor <= 1.0)) bad("timeStepFactor", timeStepFactor, "(0, 1]");
   if (!(timeStep >= 0.0)) bad("timeStep", timeStep, "[0, inf) s");
   if (!(localDamping >= 0.0 && localDamping < 1.0)) bad("localDamping", localDamping, "[0, 1)");
-  if (!(restitution > 0.0 && restitution <= 1.0)) bad("restitution", restitution, "(0, 1]");
+  if (!(restitution >= kMinRestitution && restitution <= 1.0)) bad("restitution", restitution, "[0.01, 1]");
   if (!(densityScale >= 1.0)) bad("densityScale", densityScale, "[1, inf)");
   if (!(skin >= 0.0)) bad("skin", skin, "[0, inf) m");
   if (threads < 1 || threads > 1024) bad("threads", threads, "[1, 1024]");

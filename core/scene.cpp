@@ -109,8 +109,9 @@ std::vector<SchemaField> makeSchema() {
                   "Time step as a fraction of the Rayleigh time step (used when time_step = 0)."));
   s.push_back(num("numerics", "time_step", "s", "0", 0, 1, false, false, "Fixed time step; 0 = from time_step_factor."));
   s.push_back(num("numerics", "local_damping", "-", "0", 0, 1, false, true, "Cundall local non-viscous damping alpha."));
-  s.push_back(num("numerics", "restitution", "-", "1", 0, 1, true, false,
-                  "Restitution coefficient setting viscous contact damping (1 = none)."));
+  s.push_back(num("numerics", "restitution", "-", "1", kMinRestitution, 1, false, false,
+                  "Restitution coefficient setting viscous contact damping (1 = none; at least 0.01, where the "
+                  "damping is already ~4 times critical)."));
   s.push_back(num("numerics", "density_scale", "-", "1", 1, 1e12, false, false,
                   "Mass scaling factor (>= 1) to enlarge the time step in quasi-static runs; always reported."));
   s.push_back(num("numerics", "skin", "m", "0", 0, 1, false, false, "Verlet skin; 0 = 0.1 x mean diameter."));

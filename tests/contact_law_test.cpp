@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/contact_kernels.hpp"
+#include "core/errors.hpp"
 
 using namespace fl;
 using namespace fl::kernels;
@@ -85,4 +86,8 @@ TEST(PairMixing, EffectiveModuliFollowTheHarmonicRules) {
   EXPECT_GT(dampingRatioFromRestitution(0.5), dampingRatioFromRestitution(0.9));
   const double linear = -std::log(0.5) / std::sqrt(std::pow(std::log(0.5), 2) + kPi * kPi);
   EXPECT_NEAR(dampingRatioFromRestitution(0.5) / linear, 1.0, 0.25);
+  // the accepted range ends at kMinRestitution (a fuzzed checkpoint with e ~ 1e-300 searched for minutes)
+  EXPECT_NEAR(dampingRatioFromRestitution(kMinRestitution), 4.807, 0.01);
+  for (double e : {0.0099, 1e-300, 0.0, -0.5, 1.0001, std::nan("")})
+    EXPECT_THROW(dampingRatioFromRestitution(e), InputError) << e;
 }

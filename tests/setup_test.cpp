@@ -85,6 +85,8 @@ TEST(NumericsValidation, EachBadSettingIsRejectedWithItsName) {
   n = {};
   n.restitution = 0.0;
   expectField(n, "restitution");
+  n.restitution = 0.009;  // below kMinRestitution: the damping ratio would grow without bound
+  expectField(n, "restitution");
   n = {};
   n.densityScale = 0.5;
   expectField(n, "densityScale");
