@@ -117,8 +117,7 @@ void Simulation::contactPassBlocked() {
   const PairTable& table = m_pairs;
   Chunk* chunks = m_chunks.data();
   const Vec3* omega = arr.w;
-  updateShares();
-  m_ranges.reset(m_chunkShares, 1);
+  m_ranges.reset(m_boundary.chunkBegin, 1);  // contactPass made the shares (updateShares)
   const ThreadBoundary& tb = m_boundary;
   PassParticle* haloPass = m_haloPass.data();
   Vec3* haloW = m_haloW.data();
@@ -167,9 +166,9 @@ void Simulation::contactPassBlocked() {
     const bool all = arr.n >= kLargeStateFrom;
     const bool stream = all;  // result lines by streaming stores (kLargeStateFrom)
     const bool remote = all || nt > 1;
-    const bool own = nt == m_sharesThreads;
-    const auto ownFrom = static_cast<std::uint32_t>(own ? m_particleShares[t] : staticBegin(t, nt, arr.n));
-    const auto ownTo = static_cast<std::uint32_t>(own ? m_particleShares[t + 1] : staticBegin(t + 1, nt, arr.n));
+    const bool own = nt == m_boundary.threads;
+    const auto ownFrom = static_cast<std::uint32_t>(own ? m_boundary.begin[t] : staticBegin(t, nt, arr.n));
+    const auto ownTo = static_cast<std::uint32_t>(own ? m_boundary.begin[t + 1] : staticBegin(t + 1, nt, arr.n));
     const std::uint32_t ownSpan = all ? 0 : ownTo - ownFrom;  // every partner lies outside an empty span
     ThreadRuns runs(m_ranges, t, nt, nchunks);  // the chunks this thread computes, run by run
     for (std::size_t runBegin, runEnd; runs.next(runBegin, runEnd);)
@@ -311,7 +310,7 @@ void Simulation::contactPassMindlinDeresiewicz() {
   const PairTable& table = m_pairs;
   Chunk* chunks = m_chunks.data();
   updateShares();
-  m_ranges.reset(m_chunkShares, 1);
+  m_ranges.reset(m_boundary.chunkBegin, 1);
 #pragma omp parallel num_threads(m_num.threads)
   {
   ThreadRuns runs(m_ranges, omp_get_thread_num(), omp_get_num_threads(), nchunks);

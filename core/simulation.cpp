@@ -147,7 +147,7 @@ void Simulation::drift() {
   const std::size_t n = m_p.size();
   double maxd2 = 0.0;
   updateShares();
-  m_ranges.reset(m_particleShares, kParticleGrain);
+  m_ranges.reset(m_boundary.begin, kParticleGrain);
 #pragma omp parallel num_threads(m_num.threads) reduction(max : maxd2)
   {
   const int thread = omp_get_thread_num();
@@ -245,24 +245,21 @@ void Simulation::packPassParticles() {
 
 void Simulation::resizeChunks() {
   m_chunks.resize(std::max<std::size_t>(1, (std::max(m_c.size(), m_p.size()) + kChunk - 1) / kChunk));
-  m_sharesThreads = 0;  // the pairs changed: the shares are made again at their first use
+  m_boundary.threads = 0;  // the pairs changed: the shares are made again at their first use
   m_seedsReady = false;
 }
 
 void Simulation::updateShares() {
   const int nt = std::max(1, m_num.threads);
-  if (m_sharesThreads == nt) return;
+  if (m_boundary.threads == nt) return;
   // each thread's particles start at the first particle of its first chunk's pairs (pairs are sorted by their
   // first particle); without a chunk each, the particles are split statically and nothing is exchanged; the
   // halo and seeds only while the state stays in cache (kLargeStateFrom)
   m_boundary = buildThreadBoundary(m_c, m_p.size(), nt, kChunk, m_p.size() < kLargeStateFrom);
-  m_chunkShares = m_boundary.chunkBegin;
-  m_particleShares = m_boundary.begin;
   m_haloPass.resize(m_boundary.halo.size());
   m_haloW.resize(m_boundary.halo.size());
   m_seeds.assign(m_boundary.seedParticle.size(), KickSeed{});
   m_seedsReady = false;
-  m_sharesThreads = nt;
 }
 
 // ---- 3. contacts: core/contact_pass.cpp ---------------------------------------------------------
@@ -295,7 +292,7 @@ void Simulation::kickPass() {
   if constexpr (kLocalDamping) m_kickWork.resize(3 * static_cast<std::size_t>(n));
   double* kickWork = m_kickWork.data();
   updateShares();
-  m_ranges.reset(m_particleShares, kParticleGrain);
+  m_ranges.reset(m_boundary.begin, kParticleGrain);
   const ThreadBoundary& tb = m_boundary;
   const KickSeed* seeds = m_seeds.data();
   const bool seedsReady = m_seedsReady;
@@ -311,12 +308,12 @@ void Simulation::kickPass() {
   // result lines to prefetch (kPrefetchEntries): all when the state outgrows the caches, else those of the pairs
   // outside this thread's own share of the pass, which another thread most likely computed (with the seeds,
   // none: they carry those entries)
-  const bool own = threads == m_sharesThreads;
+  const bool own = threads == m_boundary.threads;
   const std::size_t passChunks = (m_c.size() + kChunk - 1) / kChunk;
   const auto ownFrom = static_cast<std::uint32_t>(
-      2 * kChunk * (own ? m_chunkShares[thread] : staticBegin(thread, threads, passChunks)));
+      2 * kChunk * (own ? m_boundary.chunkBegin[thread] : staticBegin(thread, threads, passChunks)));
   const auto ownTo = static_cast<std::uint32_t>(std::min(
-      2 * m_c.size(), 2 * kChunk * (own ? m_chunkShares[thread + 1] : staticBegin(thread + 1, threads, passChunks))));
+      2 * m_c.size(), 2 * kChunk * (own ? m_boundary.chunkBegin[thread + 1] : staticBegin(thread + 1, threads, passChunks))));
   const bool large = static_cast<std::size_t>(n) >= kLargeStateFrom;
   const bool fetch = large || (threads > 1 && !seeded);
   const std::uint32_t ownSpan = large ? 0 : ownTo - ownFrom;  // every entry lies outside an empty span

@@ -256,10 +256,10 @@ class Simulation {
   // work at ~14 and ~41 ns a particle (4000 spheres, one thread), against a claim's ~10 ns (an atomic on a line
   // its own thread holds); 32 and 128 were no better (docs/performance.md, twelfth session).
   static constexpr std::size_t kParticleGrain = 64;
-  std::vector<std::size_t> m_chunkShares, m_particleShares;  // threads + 1 bounds each (updateShares)
-  int m_sharesThreads = 0;  // the team size the shares are for; 0: to be made
   StealingRanges m_ranges;  // the claims of the current parallel loop
-  ThreadBoundary m_boundary;  // made with the shares (updateShares)
+  // the threads' shares of the pair chunks and particles (chunkBegin, begin) with the halo and seeds, for a team
+  // of m_boundary.threads (updateShares; 0: to be made)
+  ThreadBoundary m_boundary;
   std::vector<PassParticle> m_haloPass;  // halo slots: the pass copy and omega of other threads' partners
   std::vector<Vec3> m_haloW;
   std::vector<KickSeed> m_seeds;  // slot 0 stays zero
