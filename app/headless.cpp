@@ -102,7 +102,7 @@ void printSummary(const Runner& run) {
   std::printf("profile (%ld steps, %ld neighbour rebuilds):", prof.steps, prof.rebuilds);
   for (int k = 0; k < static_cast<int>(Stage::Count); ++k)
     std::printf(" %s %.1f%%", stageName(static_cast<Stage>(k)), 100.0 * prof.seconds[k] / std::max(prof.total(), 1e-300));
-  std::printf("\n");
+  std::printf(" (the kick holds the next step's drift in %ld steps)\n", prof.fusedKicks);
   if (!run.samples().empty()) {
     double maxI = 0, maxErr = 0, maxMargin = 0;
     for (const Sample& s : run.samples()) {

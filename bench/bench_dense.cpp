@@ -351,7 +351,8 @@ int main(int argc, char** argv) {
     for (int s = 0; s < static_cast<int>(Stage::Count); ++s)
       std::printf("  %s %.3f (%.0f%%)", stageName(static_cast<Stage>(s)), r.profile.seconds[s],
                   100.0 * r.profile.seconds[s] / tot);
-    std::printf("\n");
+    std::printf("  (the kick holds the next drift in %ld of %ld steps: Simulation::run)\n", r.profile.fusedKicks,
+                r.profile.steps);
   }
   for (const Result& r : results)
     std::printf("after %ld steps, %d thread(s): p = %.6g Pa, Z = %.6f\n", o.steps, r.threads, r.pEnd, r.zEnd);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <filesystem>
 #include <fstream>
 #include <cstring>
@@ -300,11 +301,14 @@ void Runner::finishStage() {
 }
 
 bool Runner::advance(long maxSteps) {
-  for (long k = 0; k < maxSteps; ++k) {
+  for (long k = 0; k < maxSteps;) {
     if (finished()) return false;
     if (!m_stageStarted) startStage();
-    m_sim->step();
-    ++m_stageSteps;
+    // the steps before the batch's last need nothing of the runner: the engine runs them as one (Simulation::run)
+    const long batch = std::min(maxSteps - k, quietSteps());
+    m_sim->run(batch);
+    k += batch;
+    m_stageSteps += batch;
     if (!m_energyBaselineSet) {
       // after the first contact pass of this run: a specimen branched into another material carries
       // elastic energies computed with the old stiffness until then
@@ -326,6 +330,51 @@ bool Runner::advance(long maxSteps) {
     if (stageDone()) finishStage();
   }
   return !finished();
+}
+
+// How many steps the engine may run before the runner next has something to do: every step of the batch but
+// the last must be one after which advance() would only count it (no check, sample, output, reversal or end of
+// stage), so that the batch gives the bits of as many single steps. Events on a step count are exact; those on
+// the axial strain (reversals, the cyclic samples, a triaxial stage's end) are predicted from the strain rate,
+// which the servo holds constant between them, with two steps to spare against round-off.
+long Runner::quietSteps() const {
+#ifdef FL_VALIDATION
+  return 1;  // the invariants are checked after every step
+#endif
+  if (!m_energyBaselineSet) return 1;
+  const StageSpec& st = m_scene.stages[m_stage];
+  if (st.type == StageType::K0 && st.untilIsotropic) return 1;  // its axial target follows every step
+  long quiet = std::numeric_limits<long>::max();
+  auto before = [&](long stepsToEvent) { quiet = std::min(quiet, std::max(1L, stepsToEvent)); };
+  // the next multiple of n after `done` steps, counted from now
+  auto toMultiple = [](long done, long n) { return n - done % n; };
+  const OutputSpec& out = m_scene.output;
+  before(toMultiple(m_stageSteps, out.checkInterval));
+  if (st.maxSteps > 0) before(st.maxSteps - m_stageSteps);
+  if (!out.directory.empty()) {
+    if (out.vtkInterval > 0) before(toMultiple(m_sim->stepCount(), out.vtkInterval));
+    if (out.checkpointInterval > 0) before(toMultiple(m_sim->stepCount(), out.checkpointInterval));
+  }
+  if (st.type != StageType::Cyclic) before(m_lastSample + out.sampleInterval - m_stageSteps);
+  if (st.type == StageType::Triaxial || st.type == StageType::Cyclic) {
+    const double epsA = -std::log(m_sim->cell().matrix()(2, 2) / m_stageH0(2, 2));
+    const double perStep = -m_sim->cell().velocityGradient()(2, 2) * m_sim->timeStep();  // d eps_a per step
+    // steps that certainly stay short of `target` (none left if the strain is there already)
+    auto toStrain = [&](double target) {
+      const double steps = (target - epsA) / perStep;
+      if (steps > 0 && std::isfinite(steps)) before(static_cast<long>(std::min(steps, 1e15)) - 2);
+    };
+    if (st.type == StageType::Triaxial) {
+      toStrain(st.axialStrain);
+    } else {
+      const double A = st.amplitude, every = 4.0 * A / st.samplesPerCycle;
+      toStrain(m_lastSampleStrain + every);
+      toStrain(m_lastSampleStrain - every);
+      const double thresholds[4] = {A, 0.0, -A, 0.0};  // of quarters 0-3 (stepStage)
+      toStrain(thresholds[m_quarter]);
+    }
+  }
+  return quiet;
 }
 
 double Runner::stageProgress() const {

@@ -100,6 +100,7 @@ class Runner {
   void startStage();
   void finishStage();
   void stepStage();
+  long quietSteps() const;  // steps that may run as one batch (advance)
   void takeSample();
   bool stageDone();
   void closeCycle();

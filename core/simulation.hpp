@@ -8,8 +8,9 @@
 //                 tangential law (numerics.tangentialModel) is a template parameter chosen once per pass.
 //                 What only measurements read (the diagnostics' extremes, the elastic energies) is read off
 //                 the stored contacts when asked for, not computed every step
-//   4. kick       forces gathered per particle in a fixed order, half kick v += dt/2 a
-//   5. control    the cell controller (if any) sets L for the next step
+//   4. control    the cell controller (if any) sets L for the next step from the pass's stress
+//   5. kick       forces gathered per particle in a fixed order, half kick v += dt/2 a
+// run(n) fuses each step's kick with the next step's drift: one sweep over the particles instead of two.
 // Deterministic: every reduction is over fixed-size chunks summed in chunk order, and forces are gathered
 // per particle from the CSR adjacency, so the bits do not depend on the thread count, nor on which thread
 // computed what: the parallel loops balance their work between the threads as they go (work_stealing.hpp),
@@ -49,6 +50,7 @@ struct StageProfile {
   long steps = 0;
   long rebuilds = 0;
   long stolenRuns = 0;  // runs of a parallel loop one thread took from another's share (work_stealing.hpp)
+  long fusedKicks = 0;  // steps whose kick ran with the next step's drift (Simulation::run)
   double total() const;
 };
 
@@ -84,9 +86,9 @@ class Simulation {
   Simulation& operator=(Simulation&&) noexcept;
 
   void step();
-  void run(long steps) {
-    for (long k = 0; k < steps; ++k) step();
-  }
+  // steps whole steps, the same bits as calling step() as often; between them nobody can look at the state,
+  // so each step's closing kick is fused with the next step's drift (simulation.cpp)
+  void run(long steps);
 
   // state
   const ParticleStore& particles() const { return m_p; }
@@ -160,8 +162,11 @@ class Simulation {
   void reconfigure(const Material& material, const NumericsSettings& numerics);
 
  private:
+  struct DriftPlan;  // the cell's step and the damping, which every particle's drift shares
+  DriftPlan beginDrift();  // advances the cell by one step and books its boundary work
   void drift();
   bool needsRebuild() const;
+  void forcesAndControl();  // neighbours, contacts, the clock and the controller
   void rebuildNeighbours();
   void resizeChunks();  // m_chunks for the current pair and particle counts
   void packPassParticles();  // m_pass from the particle store, whole
@@ -190,9 +195,10 @@ class Simulation {
   // Sizes the Mindlin–Deresiewicz history array for the selected law (empty for the default law; when
   // switching to it, fresh histories start from the stored normal forces).
   void syncTangentialHistory();
-  void kick();
-  template <bool kLocalDamping, bool kSeeded>
-  void kickPass();  // kSeeded: the last pass summed the seeds of this team
+  void kick(bool thenDrift = false);  // thenDrift: with the next step's drift (run)
+  // kSeeded: the last pass summed the seeds of this team; kDrift: each particle then drifts by *plan
+  template <bool kLocalDamping, bool kSeeded, bool kDrift>
+  void kickPass(const DriftPlan* plan);
   // The threads' own shares of the pair chunks (a static split) and of the particles (each thread's starting
   // where the pairs of its first chunk start, so that it drifts and kicks the particles whose pairs it computes
   // as first particle), with the halo and seeds between them (thread_boundary.hpp), for m_num.threads; made

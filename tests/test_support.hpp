@@ -88,4 +88,15 @@ inline void expectSameBits(const Simulation& a, const Simulation& b) {
   EXPECT_EQ(std::memcmp(a.contactStress().data(), b.contactStress().data(), sizeof(Mat3)), 0);
 }
 
+// Expects the energy ledgers of a and b to hold the same bits, term by term.
+inline void expectSameEnergy(Simulation& a, Simulation& b) {
+  const EnergyLedger& ea = a.energy();
+  const EnergyLedger& eb = b.energy();
+  EXPECT_EQ(ea.localDampingWork, eb.localDampingWork);
+  EXPECT_EQ(ea.contactDampingWork, eb.contactDampingWork);
+  EXPECT_EQ(ea.frictionWork, eb.frictionWork);
+  EXPECT_EQ(ea.boundaryWork, eb.boundaryWork);
+  EXPECT_EQ(ea.kinetic, eb.kinetic);
+}
+
 }  // namespace fl::test
