@@ -103,7 +103,7 @@ void Simulation::step() {
   sec[int(Stage::Drift)] += std::chrono::duration<double>(t1 - t0).count();
   forcesAndControl();
   auto t2 = Clock::now();
-  kick();
+  kick(KickMode::Alone);
   sec[int(Stage::Kick)] += since(t2);
   ++m_profile.steps;
 }
@@ -114,9 +114,9 @@ void Simulation::run(long steps) {
   // write the same particle lines: between two steps of one run nobody looks at the state, so they are one
   // sweep (kickPass<..., kDrift>), with the same arithmetic in the same order as step() after step(): the same
   // bits (tests/fused_run_test.cpp). The fused kick keeps the force and torque in registers for the drift and
-  // does not store them; the last step's kick stands alone and does, so the run ends on a whole step. 4000
-  // spheres 2.5 % faster on 1 thread and 3.1 % on 2 (bench/ab.sh, 10 rounds), a 4000-sphere cyclic run through
-  // the runner 3-4 % (docs/performance.md, twentieth session).
+  // does not store them, and leaves x and v in the pass copy alone (m_storeBehind); the last step's kick
+  // stands alone and writes them all back, so the run ends on a whole step. 4000 spheres ~4.5 % faster on 1
+  // thread and ~4 % on 2, 256 000 spheres 4-8 % (bench/ab.sh; docs/performance.md, twentieth session).
   auto& sec = m_profile.seconds;
   auto t0 = Clock::now();
   drift();
@@ -125,10 +125,10 @@ void Simulation::run(long steps) {
     forcesAndControl();
     auto t1 = Clock::now();
     if (k + 1 < steps) {
-      kick(true);  // this step's closing kick and the next step's drift
+      kick(KickMode::ThenDrift);  // this step's closing kick and the next step's drift
       ++m_profile.fusedKicks;
     } else {
-      kick();
+      kick(KickMode::Closing);  // and x and v back into the store
     }
     sec[int(Stage::Kick)] += since(t1);  // with the next step's drift when fused
     ++m_profile.steps;
@@ -266,6 +266,12 @@ bool Simulation::needsRebuild() const {
 
 void Simulation::rebuildNeighbours() {
   const std::size_t n = m_p.size();
+  if (m_storeBehind) {  // inside run(): x and v are the pass copy's
+    for (std::size_t i = 0; i < n; ++i) {
+      m_p.pos[i] = m_pass[i].x;
+      m_p.vel[i] = m_pass[i].v;
+    }
+  }
   // keys of the old pairs that carry history, with the image counters before wrapping
   struct OldKey {
     std::int32_t i, j;
@@ -340,22 +346,35 @@ void Simulation::updateShares() {
 // ---- 3. contacts: core/contact_pass.cpp ---------------------------------------------------------
 
 // ---- 4. kick ------------------------------------------------------------------------------------
-void Simulation::kick(bool thenDrift) {
+void Simulation::kick(KickMode mode) {
   // seeds only after a pass that summed them (thread_boundary.hpp); one thread never has any
   const bool seeds = m_seedsReady;
   const bool damping = m_num.localDamping > 0.0;
-  if (thenDrift) {
-    const DriftPlan d = beginDrift();  // the next step's cell; the kick reads no cell
-    if (damping) seeds ? kickPass<true, true, true>(&d) : kickPass<true, false, true>(&d);
-    else seeds ? kickPass<false, true, true>(&d) : kickPass<false, false, true>(&d);
-    return;
+  switch (mode) {
+    case KickMode::ThenDrift: {
+      const DriftPlan d = beginDrift();  // the next step's cell; the kick reads no cell
+      if (damping) seeds ? kickPass<true, true, KickMode::ThenDrift>(&d) : kickPass<true, false, KickMode::ThenDrift>(&d);
+      else seeds ? kickPass<false, true, KickMode::ThenDrift>(&d) : kickPass<false, false, KickMode::ThenDrift>(&d);
+      m_storeBehind = true;
+      return;
+    }
+    case KickMode::Closing:
+      if (damping) seeds ? kickPass<true, true, KickMode::Closing>(nullptr) : kickPass<true, false, KickMode::Closing>(nullptr);
+      else seeds ? kickPass<false, true, KickMode::Closing>(nullptr) : kickPass<false, false, KickMode::Closing>(nullptr);
+      m_storeBehind = false;
+      return;
+    case KickMode::Alone:
+      if (damping) seeds ? kickPass<true, true, KickMode::Alone>(nullptr) : kickPass<true, false, KickMode::Alone>(nullptr);
+      else seeds ? kickPass<false, true, KickMode::Alone>(nullptr) : kickPass<false, false, KickMode::Alone>(nullptr);
+      return;
   }
-  if (damping) seeds ? kickPass<true, true, false>(nullptr) : kickPass<true, false, false>(nullptr);
-  else seeds ? kickPass<false, true, false>(nullptr) : kickPass<false, false, false>(nullptr);
 }
 
-template <bool kLocalDamping, bool kSeeded, bool kDrift>
+template <bool kLocalDamping, bool kSeeded, Simulation::KickMode kMode>
 void Simulation::kickPass(const DriftPlan* plan) {
+  constexpr bool kDrift = kMode == KickMode::ThenDrift;
+  // after a drift of run(), the pass copy holds x and the mid-step v (the store's may be behind: m_storeBehind)
+  constexpr bool kFromPass = kMode != KickMode::Alone;
   const int n = static_cast<int>(m_p.size());
   const std::size_t nchunks = (static_cast<std::size_t>(n) + kChunk - 1) / kChunk;
   const double h = 0.5 * m_dt;
@@ -408,10 +427,8 @@ void Simulation::kickPass(const DriftPlan* plan) {
   ThreadRuns runs(m_ranges, thread, threads, static_cast<std::size_t>(n));  // the particles this thread kicks, run by run
   for (std::size_t begin, end; runs.next(begin, end);)
   for (std::size_t i = begin; i < end; ++i) {
-    if (kDrift && thread > 0 && i + kPrefetchAhead < static_cast<std::size_t>(n)) {  // as the drift does
-      __builtin_prefetch(x + i + kPrefetchAhead, 1);
+    if (kDrift && thread > 0 && i + kPrefetchAhead < static_cast<std::size_t>(n))  // as the drift does
       __builtin_prefetch(pass + i + kPrefetchAhead, 1);
-    }
     // Pairs that do not touch hold a zero force (the contact pass keeps it so), so they are gathered
     // without a branch: adding zero changes nothing but the sign of a zero. Scalar sums: with Eigen
     // temporaries g++ spilled a cross product as two 8-byte stores read back as one 16-byte load, a
@@ -437,24 +454,25 @@ void Simulation::kickPass(const DriftPlan* plan) {
       F[i] = fu;
       T[i] = tu;
     }
+    const Vec3 vmid = kFromPass ? pass[i].v : v[i];
     if constexpr (kLocalDamping) {
       // Cundall non-viscous damping: each component of the force opposes the velocity by alpha |F|
       for (int a = 0; a < 3; ++a) {
-        f[a] = std::fma(-alpha * std::abs(f[a]), signOf(v[i][a]), f[a]);
+        f[a] = std::fma(-alpha * std::abs(f[a]), signOf(vmid[a]), f[a]);
         t[a] = std::fma(-alpha * std::abs(t[a]), signOf(w[i][a]), t[a]);
-        kickWork[3 * i + a] = alpha * (std::abs(fu[a] * v[i][a]) + std::abs(tu[a] * w[i][a])) * m_dt;
+        kickWork[3 * i + a] = alpha * (std::abs(fu[a] * vmid[a]) + std::abs(tu[a] * w[i][a])) * m_dt;
       }
     }
-    if constexpr (kDrift) {  // the velocities stay in registers for the drift (no store read back)
-      Vec3 vi = halfKick(v[i], h * im[i], f), wi = halfKick(w[i], h * ii[i], t);
-      maxd2 = std::max(maxd2, driftParticle(d, fu, tu, vi, wi, im[i], ii[i], x[i], x0[i],
-                                            pass[i]));
-      v[i] = vi;
-      w[i] = wi;
+    Vec3 vi = halfKick(vmid, h * im[i], f), wi = halfKick(w[i], h * ii[i], t);
+    if constexpr (kDrift) {
+      // x and v stay in the pass copy alone until the run's closing kick (or a rebuild) writes them back
+      Vec3 xi = pass[i].x;
+      maxd2 = std::max(maxd2, driftParticle(d, fu, tu, vi, wi, im[i], ii[i], xi, x0[i], pass[i]));
     } else {
-      v[i] = halfKick(v[i], h * im[i], f);
-      w[i] = halfKick(w[i], h * ii[i], t);
+      v[i] = vi;
+      if constexpr (kFromPass) x[i] = pass[i].x;
     }
+    w[i] = wi;
   }
   if constexpr (kLocalDamping) {
     // the work of each fixed chunk of particles, summed in particle order: the same bits for any split

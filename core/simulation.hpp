@@ -195,9 +195,14 @@ class Simulation {
   // Sizes the Mindlin–Deresiewicz history array for the selected law (empty for the default law; when
   // switching to it, fresh histories start from the stored normal forces).
   void syncTangentialHistory();
-  void kick(bool thenDrift = false);  // thenDrift: with the next step's drift (run)
-  // kSeeded: the last pass summed the seeds of this team; kDrift: each particle then drifts by *plan
-  template <bool kLocalDamping, bool kSeeded, bool kDrift>
+  enum class KickMode {
+    Alone,      // step(): v in the store
+    ThenDrift,  // run(): each particle then drifts by *plan; x and v are left in the pass copy alone
+    Closing,    // run()'s last kick: x and the mid-step v read from the pass copy, and written back to the store
+  };
+  void kick(KickMode mode);
+  // kSeeded: the last pass summed the seeds of this team
+  template <bool kLocalDamping, bool kSeeded, KickMode kMode>
   void kickPass(const DriftPlan* plan);
   // The threads' own shares of the pair chunks (a static split) and of the particles (each thread's starting
   // where the pairs of its first chunk start, so that it drifts and kicks the particles whose pairs it computes
@@ -270,6 +275,9 @@ class Simulation {
   std::vector<Vec3> m_haloW;
   std::vector<KickSeed> m_seeds;  // slot 0 stays zero
   bool m_seedsReady = false;      // the last pass summed the seeds for this team
+  // inside run(), after a fused kick and drift: the particle store's x and v are behind the pass copy's (its
+  // closing kick and rebuilds bring them back)
+  bool m_storeBehind = false;
 };
 
 }  // namespace fl

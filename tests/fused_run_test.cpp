@@ -1,5 +1,6 @@
 // Simulation::run(n) fuses each step's closing kick with the next step's drift (one sweep over the particles
-// instead of two) and stores the forces and torques only at the last step: it must give the bits of n calls of
+// instead of two), stores the forces and torques only at the last step and keeps x and v in the contact pass's
+// copy alone until then (a rebuild brings the store up to date first): it must give the bits of n calls of
 // step(), with local damping and the energy ledger, a moving cell, neighbour rebuilds, a controller, either
 // tangential law and any thread count, and however the steps are split into runs.
 #include <gtest/gtest.h>
