@@ -14,17 +14,15 @@
 
 using namespace fl;
 
-using test::compressingGas;
-using test::compressingGasWith;
-using test::expectSameBits;
-using test::sameBits;
+// qualified names (test::): in the unity builds of CI's reliability pass this file shares one translation unit
+// with others that declare their own helpers of the same names
 
 namespace {
 // Everything run() and step() touch beyond expectSameBits: the pass copy, the clock, the cell, the rebuilds
 // and the energy ledger.
 void expectSameRun(Simulation& a, Simulation& b) {
-  expectSameBits(a, b);
-  EXPECT_TRUE(sameBits(a.passParticles(), b.passParticles()));
+  test::expectSameBits(a, b);
+  EXPECT_TRUE(test::sameBits(a.passParticles(), b.passParticles()));
   EXPECT_EQ(a.stepCount(), b.stepCount());
   EXPECT_EQ(a.time(), b.time());
   EXPECT_EQ(std::memcmp(a.cell().matrix().data(), b.cell().matrix().data(), sizeof(Mat3)), 0);
@@ -43,7 +41,7 @@ void stepByStep(Simulation& sim, long steps) {
 TEST(FusedRun, RunGivesTheBitsOfStepByStep) {
   for (int threads : {1, 3}) {
     SCOPED_TRACE(threads);
-    Simulation a = compressingGas(threads), b = compressingGas(1);
+    Simulation a = test::compressingGas(threads), b = test::compressingGas(1);
     a.run(3000);
     stepByStep(b, 3000);
     ASSERT_GT(a.contacts().activeCount(), 1000u) << "the test must exercise many contacts";
@@ -55,7 +53,7 @@ TEST(FusedRun, RunGivesTheBitsOfStepByStep) {
 
 // The steps split into runs of any length (one step, a run of two) give the same bits as one run.
 TEST(FusedRun, HowTheStepsAreSplitIntoRunsChangesNoBit) {
-  Simulation a = compressingGas(2, 0.0, 1.0, false), b = compressingGas(2, 0.0, 1.0, false);
+  Simulation a = test::compressingGas(2, 0.0, 1.0, false), b = test::compressingGas(2, 0.0, 1.0, false);
   a.run(2500);
   b.run(1000);
   b.run(1);
@@ -71,7 +69,7 @@ TEST(FusedRun, HowTheStepsAreSplitIntoRunsChangesNoBit) {
 // next drift alike whether that drift is fused with the kick or not.
 TEST(FusedRun, AControlledRunGivesTheBitsOfStepByStep) {
   auto controlled = [](int threads) {
-    Simulation sim = compressingGas(threads);
+    Simulation sim = test::compressingGas(threads);
     ServoSettings s;
     s.maxStrainRate = 1000.0;  // the gas must reach contact within the test's steps
     sim.setController(std::make_shared<AxisServo>(
@@ -95,12 +93,12 @@ TEST(FusedRun, MindlinDeresiewiczRunGivesTheBitsOfStepByStep) {
   num.restitution = 0.5;
   num.localDamping = 0.05;
   num.tangentialModel = TangentialModel::MindlinDeresiewicz;
-  Simulation a = compressingGasWith(1500, num);
+  Simulation a = test::compressingGasWith(1500, num);
   num.threads = 1;
-  Simulation b = compressingGasWith(1500, num);
+  Simulation b = test::compressingGasWith(1500, num);
   a.run(3000);
   stepByStep(b, 3000);
   ASSERT_GT(a.contacts().activeCount(), 500u);
   expectSameRun(a, b);
-  EXPECT_TRUE(sameBits(a.contacts().mdHistory, b.contacts().mdHistory));
+  EXPECT_TRUE(test::sameBits(a.contacts().mdHistory, b.contacts().mdHistory));
 }
