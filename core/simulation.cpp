@@ -188,8 +188,8 @@ namespace {
 // the same bits in both: g++ fuses multiplies and adds into FMAs (-ffp-contract=fast, its default for C++) as
 // each loop's context allows, so the integrator's multiply-adds are written as FMAs and leave it nothing to fuse.
 
-// v += c f, one half kick (c = dt/2 over the mass or the moment of inertia)
-[[gnu::always_inline]] inline Vec3 halfKick(const Vec3& v, double c, const Vec3& f) {
+// v + c f: a half kick (c = dt/2 over the mass or the moment of inertia) or a move (c = dt)
+[[gnu::always_inline]] inline Vec3 plusScaled(const Vec3& v, double c, const Vec3& f) {
   return Vec3(std::fma(c, f.x(), v.x()), std::fma(c, f.y(), v.y()), std::fma(c, f.z(), v.z()));
 }
 
@@ -211,9 +211,9 @@ template <class Plan>
       t[k] = std::fma(-d.alpha * std::abs(t[k]), signOf(w[k]), t[k]);
     }
   }
-  v = halfKick(v, d.h * im, f);
-  w = halfKick(w, d.h * ii, t);
-  x = d.affine ? affineMap(d.phi, x, d.dt * v) : halfKick(x, d.dt, v);  // Phi x + dt v, or x + dt v
+  v = plusScaled(v, d.h * im, f);
+  w = plusScaled(w, d.h * ii, t);
+  x = d.affine ? affineMap(d.phi, x, d.dt * v) : plusScaled(x, d.dt, v);  // Phi x + dt v, or x + dt v
   pass.x = x;
   pass.v = v;
   const Vec3 u = affineMap(-d.Fref, x0, x);
@@ -347,27 +347,29 @@ void Simulation::updateShares() {
 
 // ---- 4. kick ------------------------------------------------------------------------------------
 void Simulation::kick(KickMode mode) {
-  // seeds only after a pass that summed them (thread_boundary.hpp); one thread never has any
-  const bool seeds = m_seedsReady;
-  const bool damping = m_num.localDamping > 0.0;
   switch (mode) {
     case KickMode::ThenDrift: {
       const DriftPlan d = beginDrift();  // the next step's cell; the kick reads no cell
-      if (damping) seeds ? kickPass<true, true, KickMode::ThenDrift>(&d) : kickPass<true, false, KickMode::ThenDrift>(&d);
-      else seeds ? kickPass<false, true, KickMode::ThenDrift>(&d) : kickPass<false, false, KickMode::ThenDrift>(&d);
+      kickIn<KickMode::ThenDrift>(&d);
       m_storeBehind = true;
       return;
     }
     case KickMode::Closing:
-      if (damping) seeds ? kickPass<true, true, KickMode::Closing>(nullptr) : kickPass<true, false, KickMode::Closing>(nullptr);
-      else seeds ? kickPass<false, true, KickMode::Closing>(nullptr) : kickPass<false, false, KickMode::Closing>(nullptr);
+      kickIn<KickMode::Closing>(nullptr);
       m_storeBehind = false;
       return;
     case KickMode::Alone:
-      if (damping) seeds ? kickPass<true, true, KickMode::Alone>(nullptr) : kickPass<true, false, KickMode::Alone>(nullptr);
-      else seeds ? kickPass<false, true, KickMode::Alone>(nullptr) : kickPass<false, false, KickMode::Alone>(nullptr);
+      kickIn<KickMode::Alone>(nullptr);
       return;
   }
+}
+
+template <Simulation::KickMode kMode>
+void Simulation::kickIn(const DriftPlan* plan) {
+  // seeds only after a pass that summed them (thread_boundary.hpp); one thread never has any
+  const bool seeds = m_seedsReady;
+  if (m_num.localDamping > 0.0) seeds ? kickPass<true, true, kMode>(plan) : kickPass<true, false, kMode>(plan);
+  else seeds ? kickPass<false, true, kMode>(plan) : kickPass<false, false, kMode>(plan);
 }
 
 template <bool kLocalDamping, bool kSeeded, Simulation::KickMode kMode>
@@ -463,7 +465,7 @@ void Simulation::kickPass(const DriftPlan* plan) {
         kickWork[3 * i + a] = alpha * (std::abs(fu[a] * vmid[a]) + std::abs(tu[a] * w[i][a])) * m_dt;
       }
     }
-    Vec3 vi = halfKick(vmid, h * im[i], f), wi = halfKick(w[i], h * ii[i], t);
+    Vec3 vi = plusScaled(vmid, h * im[i], f), wi = plusScaled(w[i], h * ii[i], t);
     if constexpr (kDrift) {
       // x and v stay in the pass copy alone until the run's closing kick (or a rebuild) writes them back
       Vec3 xi = pass[i].x;

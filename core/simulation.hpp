@@ -201,6 +201,8 @@ class Simulation {
     Closing,    // run()'s last kick: x and the mid-step v read from the pass copy, and written back to the store
   };
   void kick(KickMode mode);
+  template <KickMode kMode>
+  void kickIn(const DriftPlan* plan);  // picks the kick for the damping and the seeds
   // kSeeded: the last pass summed the seeds of this team
   template <bool kLocalDamping, bool kSeeded, KickMode kMode>
   void kickPass(const DriftPlan* plan);
