@@ -13,7 +13,10 @@
 // bit-identical across the thread counts it measured (house style §12).
 //
 //   bench_dense [--threads 1,2] [--steps 20000] [--repeats 5] [--cache FILE] [--export-lammps FILE]
-//               [--no-energy] [--skin METRES] [--order file|morton|shuffled] [--tile NX,NY,NZ]
+//               [--no-energy] [--skin METRES] [--order file|morton|shuffled] [--tile NX,NY,NZ] [--warmup STEPS]
+// --warmup runs that many steps of each repeat before its timed steps (and its profile): the automatic skin
+// (core/verlet_skin.hpp) narrows at the list's 64th step, so runs of a few hundred steps (1M spheres in
+// bench/scaling.sh) are timed on the settled list.
 // --tile replicates the periodic packing NX x NY x NZ times (same density, stress and contacts per particle:
 // the scaling measurement of issue 6 uses 1,1,1 / 2,2,2 / 4,4,4 / 6,6,7 = 4k, 32k, 256k, 1M spheres).
 #include <algorithm>
@@ -53,11 +56,12 @@ constexpr double kDt = 1e-7;               // [s]
 struct Options {
   std::vector<int> threads{1, 2};
   long steps = 20000;
+  long warmup = 0;  // untimed steps before each repeat's timed ones
   int repeats = 5;
   std::string cache = "build/bench-cache/dense4000_318kPa.state";
   std::string exportLammps;
   bool trackEnergy = true;
-  double skin = 0.0;  // 0: the engine's default (0.1 x mean diameter)
+  double skin = 0.0;  // 0: the engine's automatic skin (core/verlet_skin.hpp)
   std::array<int, 3> tile{1, 1, 1};  // periodic replicas of the packing per axis
   // particle order: Z-order (core/spatial_order.hpp), the cached packing's, or a seeded random permutation
   // (what a packing imported in arbitrary order would run at, were it not sorted)
@@ -98,6 +102,9 @@ Options parse(int argc, char** argv) {
       o.exportLammps = value();
     } else if (a == "--no-energy") {
       o.trackEnergy = false;
+    } else if (a == "--warmup") {
+      o.warmup = std::atol(value().c_str());
+      if (o.warmup < 0) usage("--warmup takes a number of steps >= 0");
     } else if (a == "--skin") {
       o.skin = std::atof(value().c_str());
     } else if (a == "--tile") {
@@ -257,6 +264,17 @@ std::uint64_t stateFingerprint(const Simulation& sim) {
   return fnv1a64(w.bytes());
 }
 
+// The skin the run settles to: the fixed one, or the automatic skin after 4096 untimed steps of the untiled
+// packing on one thread (the tiles replicate it: the same displacements, the same skin).
+double settledSkin(const Simulation& prepared, const Options& o) {
+  if (o.skin > 0.0) return o.skin;
+  Options one = o;
+  one.tile = {1, 1, 1};
+  Simulation s = measuredScene(prepared, 1, one);
+  s.run(4096);
+  return s.skin();
+}
+
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
@@ -287,10 +305,13 @@ int main(int argc, char** argv) {
       writeLammpsData(o.exportLammps, s0.particles(), s0.cell(), s0.materials());
       const Material& m = s0.materials().at(0);
       // machine-readable line for bench/lammps_side_by_side.sh
+      // LAMMPS keeps one skin through its run: it gets the one FabricLab's automatic skin settles to on this
+      // packing, from a short untimed run of the untiled packing; FabricLab starts from its widest skin and
+      // narrows it within its own timed steps (it pays that rebuild, LAMMPS does not)
       std::printf("export: file=%s N=%zu E=%.17g nu=%.17g mu=%.17g rho=%.17g skin=%.17g dt=%.17g p0=%.17g "
                   "Z0=%.17g\n",
-                  o.exportLammps.c_str(), n, m.youngModulus, m.poissonRatio, m.friction, m.density, s0.skin(),
-                  s0.timeStep(), p0, counts.coordination);
+                  o.exportLammps.c_str(), n, m.youngModulus, m.poissonRatio, m.friction, m.density,
+                  settledSkin(prepared, o), s0.timeStep(), p0, counts.coordination);
     }
   }
 
@@ -300,7 +321,8 @@ int main(int argc, char** argv) {
     StageProfile profile;
     std::vector<Vec3> finalPos;
     std::uint64_t fingerprint = 0;  // of the final state, to compare builds (bench/ab.sh)
-    double pEnd, zEnd;
+    std::size_t pairsEnd = 0;
+    double pEnd = 0, zEnd = 0, skinEnd = 0;  // skinEnd: the list's skin at the end (automatic: core/verlet_skin.hpp)
   };
   std::vector<Result> results;
   double memoryPerParticle = 0.0, peakResident = 0.0;
@@ -310,6 +332,10 @@ int main(int argc, char** argv) {
     std::vector<StageProfile> profiles;
     for (int r = 0; r < o.repeats; ++r) {
       Simulation sim = measuredScene(prepared, t, o);
+      if (o.warmup > 0) {
+        sim.run(o.warmup);
+        sim.resetProfile();
+      }
       const auto t0 = std::chrono::steady_clock::now();
       sim.run(o.steps);
       const double s = seconds(t0);
@@ -324,6 +350,8 @@ int main(int argc, char** argv) {
         res.fingerprint = stateFingerprint(sim);
         res.pEnd = sim.contactStress().trace() / 3.0;
         res.zEnd = contactCounts(sim).coordination;
+        res.skinEnd = sim.skin();
+        res.pairsEnd = sim.contacts().size();
       }
     }
     res.median = median(rates);
@@ -355,7 +383,8 @@ int main(int argc, char** argv) {
                 r.profile.steps);
   }
   for (const Result& r : results)
-    std::printf("after %ld steps, %d thread(s): p = %.6g Pa, Z = %.6f\n", o.steps, r.threads, r.pEnd, r.zEnd);
+    std::printf("after %ld steps, %d thread(s): p = %.6g Pa, Z = %.6f, skin = %.6g m, pairs in list %zu\n", o.steps,
+                r.threads, r.pEnd, r.zEnd, r.skinEnd, r.pairsEnd);
   if (results.size() > 1) {
     for (std::size_t k = 1; k < results.size(); ++k)
       std::printf("speed-up %d vs %d threads: %.3f\n", results[k].threads, results[0].threads,

@@ -57,7 +57,7 @@ struct NumericsSettings {
   double localDamping = 0.0;     // Cundall non-viscous damping alpha [-], [0, 1)
   double restitution = 1.0;      // contact restitution e setting viscous contact damping; 1 = none [-]
   double densityScale = 1.0;     // mass and inertia multiplier (>= 1), always reported [-]
-  double skin = 0.0;             // Verlet skin [m]; 0 = 0.1 x mean diameter
+  double skin = 0.0;             // Verlet skin [m]; 0 = automatic (core/verlet_skin.hpp)
   bool trackEnergy = true;       // accumulate elastic energy and dissipation every step
   int threads = 1;               // OpenMP threads; results are identical for any count
   TangentialModel tangentialModel = TangentialModel::MindlinNoSlip;  // last: checkpoints of state v2 end before it

@@ -114,7 +114,7 @@ std::vector<SchemaField> makeSchema() {
                   "damping is already ~4 times critical)."));
   s.push_back(num("numerics", "density_scale", "-", "1", 1, 1e12, false, false,
                   "Mass scaling factor (>= 1) to enlarge the time step in quasi-static runs; always reported."));
-  s.push_back(num("numerics", "skin", "m", "0", 0, 1, false, false, "Verlet skin; 0 = 0.1 x mean diameter."));
+  s.push_back(num("numerics", "skin", "m", "0", 0, 1, false, false, "Verlet skin; 0 = automatic: 0.1 x mean diameter at first, then adapted at rebuilds to how fast the particles move (0.002-0.1 x mean diameter)."));
   s.push_back(integer("numerics", "threads", "0", 0, 1024, "OpenMP threads; 0 = all cores. Results do not depend on it."));
   s.push_back(boolean("numerics", "track_energy", "true", "Accumulate the energy ledger every step."));
   s.push_back(choice("numerics", "tangential_model", tangentialModelName(TangentialModel::MindlinNoSlip),

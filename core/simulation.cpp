@@ -10,6 +10,7 @@
 
 #include "errors.hpp"
 #include "neighbor_search.hpp"
+#include "verlet_skin.hpp"
 
 namespace fl {
 
@@ -61,11 +62,8 @@ Simulation::Simulation(ParticleStore particles, PeriodicCell cell, std::vector<M
     }
   m_rayleigh = rayleighTimeStep(m_p, m_materials, m_num.densityScale);
   m_dt = m_num.timeStep > 0.0 ? m_num.timeStep : m_num.timeStepFactor * m_rayleigh;
-  double meanD = 0.0;
-  for (double r : m_p.radius) meanD += 2.0 * r;
-  meanD /= static_cast<double>(m_p.size());
-  m_skin = m_num.skin > 0.0 ? m_num.skin : 0.1 * meanD;
-  m_cutoff = 2.0 * m_p.maxRadius() + m_skin;
+  m_meanDiameter = meanDiameter(m_p);
+  setSkin(m_num.skin > 0.0 ? m_num.skin : verlet_skin::kMaxFraction * m_meanDiameter);
   refresh();
 }
 
@@ -141,7 +139,13 @@ void Simulation::run(long steps) {
 void Simulation::forcesAndControl() {
   auto& sec = m_profile.seconds;
   auto t1 = Clock::now();
-  if (needsRebuild()) {
+  ++m_listSteps;
+  // the list is rebuilt when a pair outside it may touch, or (automatic skin) when it is found much wider than
+  // the displacements need; its new skin follows them (verlet_skin.hpp)
+  const double used = displacementBound();
+  const bool automatic = !(m_num.skin > 0.0);
+  if (used > m_skin || (automatic && verlet_skin::tooWide(m_skin, used, m_listSteps, m_meanDiameter))) {
+    setSkin(automatic ? verlet_skin::optimal(used, m_listSteps, m_meanDiameter) : m_num.skin);
     rebuildNeighbours();
     ++m_profile.rebuilds;
   }
@@ -257,11 +261,22 @@ void Simulation::drift() {
 }
 
 // ---- 2. neighbours ------------------------------------------------------------------------------
-bool Simulation::needsRebuild() const {
+double Simulation::displacementBound() const {
   // A pair's gap can shrink by at most |u_i| + |u_j| (fluctuations since the rebuild) plus
   // ||F - I|| * |l| (homogeneous cell strain since the rebuild, F = H H_ref^-1, |l| <= cut-off).
   const Mat3 strain = m_cell.matrix() * m_refHinv - Mat3::Identity();
-  return 2.0 * std::sqrt(m_maxDisp2) + strain.norm() * m_cutoff > m_skin;
+  return 2.0 * std::sqrt(m_maxDisp2) + strain.norm() * m_cutoff;
+}
+
+void Simulation::setSkin(double skin) {
+  m_skin = skin;
+  m_cutoff = 2.0 * m_p.maxRadius() + m_skin;
+}
+
+double Simulation::meanDiameter(const ParticleStore& p) {
+  double d = 0.0;
+  for (double r : p.radius) d += 2.0 * r;
+  return d / static_cast<double>(p.size());
 }
 
 void Simulation::rebuildNeighbours() {
@@ -314,6 +329,7 @@ void Simulation::rebuildNeighbours() {
   m_refPos = m_p.pos;
   m_refHinv = m_cell.inverse();
   m_maxDisp2 = 0.0;
+  m_listSteps = 0;
   resizeChunks();
   packPassParticles();
 }

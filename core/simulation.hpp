@@ -106,7 +106,7 @@ class Simulation {
   double rayleighStep() const { return m_rayleigh; }  // [s], with density scaling
   // 2 sqrt(m*/k) at the stiffest current contact [s]; infinity without contacts.
   double stiffnessTimeStep() const;
-  double skin() const { return m_skin; }
+  double skin() const { return m_skin; }  // of the current neighbour list [m] (automatic: verlet_skin.hpp)
 
   // measures read from stored data
   const Mat3& contactStress() const { return m_stress; }  // [Pa], compression positive
@@ -125,6 +125,7 @@ class Simulation {
   // contacts (or the pass summed them itself): a step that nobody measured leaves it false
   bool contactsMeasured() const { return m_contactsMeasured; }
   const StageProfile& profile() const { return m_profile; }
+  void resetProfile() { m_profile = StageProfile{}; }  // e.g. after a benchmark's untimed warm-up
   // The threads' shares and what crosses between them, as the last parallel step made them (thread_boundary.hpp)
   const ThreadBoundary& threadBoundary() const { return m_boundary; }
   // Heap bytes held by the state (particle and pair arrays by capacity, history, adjacency, reduction
@@ -165,7 +166,9 @@ class Simulation {
   struct DriftPlan;  // the cell's step and the damping, which every particle's drift shares
   DriftPlan beginDrift();  // advances the cell by one step and books its boundary work
   void drift();
-  bool needsRebuild() const;
+  double displacementBound() const;  // how far the gap of a pair may have shrunk since the last rebuild [m]
+  void setSkin(double skin);  // the next list's skin, and its cut-off
+  static double meanDiameter(const ParticleStore& p);
   void forcesAndControl();  // neighbours, contacts, the clock and the controller
   void rebuildNeighbours();
   void resizeChunks();  // m_chunks for the current pair and particle counts
@@ -224,7 +227,9 @@ class Simulation {
 
   double m_dt = 0.0, m_time = 0.0, m_rayleigh = 0.0;
   long m_step = 0;
-  double m_skin = 0.0, m_cutoff = 0.0;
+  double m_skin = 0.0, m_cutoff = 0.0;  // of the current list
+  double m_meanDiameter = 0.0;  // [m], the automatic skin's unit (verlet_skin.hpp)
+  long m_listSteps = 0;         // steps since the last rebuild
   // rebuild bookkeeping
   std::vector<Vec3> m_refPos;  // positions at the last rebuild
   Mat3 m_refHinv;              // H^-1 at the last rebuild

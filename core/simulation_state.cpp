@@ -15,7 +15,8 @@ namespace {
 // 3: numerics carry the tangential model; the Mindlin–Deresiewicz history follows the contact history.
 // 2: read for compatibility (the default tangential law, no extra history); 2 and 3 give the moments from
 // their normals and forces.
-constexpr std::uint32_t kStateVersion = 4;
+// 5: the steps since the last rebuild (the automatic skin's clock, verlet_skin.hpp); older states restart it at 0.
+constexpr std::uint32_t kStateVersion = 5;
 
 // NumericsSettings as written by state version 2 (same members and order, no tangentialModel).
 struct NumericsSettingsV2 {
@@ -102,6 +103,7 @@ void Simulation::saveState(BinaryWriter& w) const {
   w.putVector(m_refPos);
   putMat(w, m_refHinv);
   w.put(m_maxDisp2);
+  w.put(m_listSteps);
   putMat(w, m_stress);
   putMat(w, m_stressPrev);
   measureContacts();  // the ledger and the diagnostics of the last pass, whole
@@ -224,10 +226,13 @@ Simulation Simulation::restoreState(BinaryReader& r) {
   s.m_step = r.get<long>("step");
   s.m_skin = r.get<double>("skin");
   s.m_cutoff = r.get<double>("cutoff");
+  s.m_meanDiameter = meanDiameter(s.m_p);
   s.m_refPos = r.getVector<Vec3>("reference positions");
   if (s.m_refPos.size() != n) r.fail("reference positions have the wrong length");
   s.m_refHinv = getMat(r, "reference inverse cell");
   s.m_maxDisp2 = r.get<double>("max displacement");
+  s.m_listSteps = version >= 5 ? r.get<long>("steps since the last rebuild") : 0;
+  if (s.m_listSteps < 0) r.fail("steps since the last rebuild must be >= 0");
   s.m_stress = getMat(r, "stress");
   s.m_stressPrev = getMat(r, "previous stress");
   s.m_energy = r.get<EnergyLedger>("energy ledger");
@@ -251,8 +256,7 @@ void Simulation::reconfigure(const Material& material, const NumericsSettings& n
   for (std::uint16_t m : m_p.material)
     if (m != 0) throw InputError("reconfigure: the specimen uses several materials; a scene defines one");
   m_materials = {material};
-  m_num = numerics;
-  m_num.skin = m_skin;
+  m_num = numerics;  // its skin applies from the next rebuild (0: automatic); the current list keeps its own
   for (std::size_t i = 0; i < m_p.size(); ++i) {
     const double r = m_p.radius[i];
     const double m = material.density * numerics.densityScale * 4.0 / 3.0 * kPi * r * r * r;

@@ -1,0 +1,141 @@
+// The automatic Verlet skin (core/verlet_skin.hpp): the rule in closed form, and in a simulation: it narrows on
+// a quiet packing and widens again when the particles move, it never misses a contact (every touching pair of
+// a brute-force search is a contact of the list), a fixed skin stays fixed, and the results stay the same for
+// any thread count and across a checkpoint that falls just before a check.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/binary_io.hpp"
+#include "core/neighbor_search.hpp"
+#include "core/verlet_skin.hpp"
+#include "test_support.hpp"
+
+namespace fl {
+namespace {
+
+constexpr double kD = 1.1e-3;  // a mean diameter [m]
+
+TEST(VerletSkinRule, OptimumIsTheSquareRootOfTheCostRatioTimesTheRate) {
+  // s* = sqrt(κ d ů), ů = used / steps: 20 µm in 2000 steps, d = 1.1 mm, κ = 4 → sqrt(4.4e-11) m = 6.6 µm
+  EXPECT_DOUBLE_EQ(verlet_skin::optimal(20e-6, 2000, kD), std::sqrt(4.0 * kD * 1e-8));
+  // four times the rate, twice the skin
+  EXPECT_DOUBLE_EQ(verlet_skin::optimal(80e-6, 2000, kD), 2.0 * verlet_skin::optimal(20e-6, 2000, kD));
+}
+
+TEST(VerletSkinRule, ClampedToItsRangeOfTheMeanDiameter) {
+  EXPECT_DOUBLE_EQ(verlet_skin::optimal(0.0, 5000, kD), verlet_skin::kMinFraction * kD);    // nothing moved
+  EXPECT_DOUBLE_EQ(verlet_skin::optimal(1e-3, 10, kD), verlet_skin::kMaxFraction * kD);     // a gas
+  EXPECT_DOUBLE_EQ(verlet_skin::optimal(1e-6, 0, kD), verlet_skin::kMaxFraction * kD);      // no step: widest
+  EXPECT_DOUBLE_EQ(verlet_skin::optimal(-1.0, 100, kD), verlet_skin::kMinFraction * kD);    // never below
+}
+
+TEST(VerletSkinRule, ChecksAtPowersOfTwoFrom64StepsAndOnlyForAFactorTwo) {
+  EXPECT_FALSE(verlet_skin::isCheckStep(0));
+  EXPECT_FALSE(verlet_skin::isCheckStep(32));
+  EXPECT_FALSE(verlet_skin::isCheckStep(63));
+  EXPECT_TRUE(verlet_skin::isCheckStep(64));
+  EXPECT_FALSE(verlet_skin::isCheckStep(96));
+  EXPECT_TRUE(verlet_skin::isCheckStep(1024));
+  EXPECT_FALSE(verlet_skin::isCheckStep(1536));
+  EXPECT_TRUE(verlet_skin::isCheckStep(2048));
+  EXPECT_TRUE(verlet_skin::isCheckStep(1L << 20));
+  const double s = verlet_skin::optimal(2e-6, 1024, kD);
+  EXPECT_TRUE(verlet_skin::tooWide(2.01 * s, 2e-6, 1024, kD));
+  EXPECT_FALSE(verlet_skin::tooWide(1.99 * s, 2e-6, 1024, kD));
+  EXPECT_FALSE(verlet_skin::tooWide(10.0 * s, 2e-6, 1025, kD));  // not a check step
+  EXPECT_FALSE(verlet_skin::tooWide(10.0 * s, 2e-6, 32, kD));
+}
+
+// Touching pairs by brute force (a search with skin 0) against the list's contacts.
+std::size_t touchingByBruteForce(const Simulation& sim) {
+  const PairList all = findPairsBruteForce(sim.particles(), sim.cell(), 0.0);
+  return all.first.size();
+}
+
+double meanDiameterOf(const Simulation& sim) {
+  double d = 0.0;
+  for (double r : sim.particles().radius) d += 2.0 * r;
+  return d / static_cast<double>(sim.particles().size());
+}
+
+// The compressing gas of the determinism tests, then held still and damped: a packing that moves less and less.
+Simulation quietingPacking(int threads) {
+  NumericsSettings num;
+  num.threads = threads;
+  num.restitution = 0.5;
+  num.localDamping = 0.05;
+  Simulation sim = test::compressingGasWith(1500, num);
+  sim.run(3000);
+  sim.setVelocityGradient(Mat3::Zero());
+  sim.setLocalDamping(0.7);
+  return sim;
+}
+
+TEST(VerletSkin, NarrowsAsTheParticlesSlowDownAndNeverMissesAContact) {
+  Simulation sim = quietingPacking(1);
+  const double meanD = meanDiameterOf(sim);
+  const long rebuildsBefore = sim.profile().rebuilds;
+  double narrowest = sim.skin();
+  for (int k = 0; k < 40; ++k) {
+    sim.run(250);
+    narrowest = std::min(narrowest, sim.skin());
+    ASSERT_GE(sim.skin(), verlet_skin::kMinFraction * meanD * (1 - 1e-12));
+    ASSERT_LE(sim.skin(), verlet_skin::kMaxFraction * meanD * (1 + 1e-12));
+    ASSERT_EQ(sim.contacts().activeCount(), touchingByBruteForce(sim)) << "after " << (k + 1) * 250 << " steps";
+  }
+  EXPECT_LT(narrowest, 0.4 * verlet_skin::kMaxFraction * meanD) << "the skin should narrow as the gas slows down";
+  EXPECT_GT(sim.profile().rebuilds, rebuildsBefore);
+}
+
+TEST(VerletSkin, WidensAgainWhenTheParticlesMove) {
+  Simulation sim = quietingPacking(1);
+  sim.run(8000);
+  const double quiet = sim.skin();
+  // compress again, fast: the displacements use the narrow skin up within a few steps
+  Mat3 L = Mat3::Zero();
+  L.diagonal() = Vec3(-400, -400, -500);
+  sim.setVelocityGradient(L);
+  sim.setLocalDamping(0.05);
+  double widest = quiet;
+  for (int k = 0; k < 10; ++k) {
+    sim.run(100);
+    widest = std::max(widest, sim.skin());
+    ASSERT_EQ(sim.contacts().activeCount(), touchingByBruteForce(sim)) << "after " << (k + 1) * 100 << " steps";
+  }
+  EXPECT_GT(widest, 2.0 * quiet);
+  EXPECT_GT(sim.contacts().activeCount(), 3000u);
+}
+
+TEST(VerletSkin, AFixedSkinStaysFixed) {
+  NumericsSettings num;
+  num.skin = 0.07e-3;
+  num.restitution = 0.5;
+  num.localDamping = 0.05;
+  Simulation sim = test::compressingGasWith(1500, num);
+  sim.run(1500);
+  sim.setVelocityGradient(Mat3::Zero());
+  sim.setLocalDamping(0.7);
+  sim.run(5000);
+  ASSERT_GT(sim.profile().rebuilds, 0);
+  EXPECT_EQ(sim.skin(), 0.07e-3);
+}
+
+TEST(VerletSkin, SameBitsForAnyThreadCountAndAcrossACheckpoint) {
+  Simulation a = quietingPacking(1), b = quietingPacking(2);
+  a.run(3000);
+  BinaryWriter w;
+  a.saveState(w);  // the list's clock is saved: the restored run checks at the same steps
+  a.run(6000);
+  b.run(9000);
+  ASSERT_LT(a.skin(), 0.5 * verlet_skin::kMaxFraction * meanDiameterOf(a)) << "the runs must cross a narrowing";
+  test::expectSameBits(a, b);
+  BinaryReader r(w.bytes(), "memory");
+  Simulation c = Simulation::restoreState(r);
+  c.run(6000);
+  test::expectSameBits(a, c);
+  EXPECT_EQ(a.skin(), c.skin());
+}
+
+}  // namespace
+}  // namespace fl
