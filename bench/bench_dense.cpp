@@ -13,7 +13,10 @@
 // bit-identical across the thread counts it measured (house style §12).
 //
 //   bench_dense [--threads 1,2] [--steps 20000] [--repeats 5] [--cache FILE] [--export-lammps FILE]
-//               [--no-energy] [--skin METRES] [--order file|morton|shuffled] [--tile NX,NY,NZ] [--warmup STEPS]
+//               [--no-energy] [--skin METRES|settled] [--order file|morton|shuffled] [--tile NX,NY,NZ]
+//               [--warmup STEPS]
+// --skin settled fixes the skin at the one the automatic skin settles to on the untiled packing (settledSkin):
+// every size of bench/scaling.sh then runs on the same list, whatever its number of steps.
 // --warmup runs that many steps of each repeat before its timed steps (and its profile): the automatic skin
 // (core/verlet_skin.hpp) narrows at the list's 64th step, so runs of a few hundred steps (1M spheres in
 // bench/scaling.sh) are timed on the settled list.
@@ -62,6 +65,7 @@ struct Options {
   std::string exportLammps;
   bool trackEnergy = true;
   double skin = 0.0;  // 0: the engine's automatic skin (core/verlet_skin.hpp)
+  bool settledSkin = false;  // --skin settled: fixed at the automatic skin's settled value (settledSkin below)
   std::array<int, 3> tile{1, 1, 1};  // periodic replicas of the packing per axis
   // particle order: Z-order (core/spatial_order.hpp), the cached packing's, or a seeded random permutation
   // (what a packing imported in arbitrary order would run at, were it not sorted)
@@ -71,8 +75,8 @@ struct Options {
 [[noreturn]] void usage(const char* msg) {
   std::fprintf(stderr,
                "bench_dense: %s\nusage: bench_dense [--threads 1,2] [--steps N] [--repeats N] [--cache FILE]\n"
-               "                   [--export-lammps FILE] [--no-energy] [--skin METRES] [--order file|morton|shuffled]\n"
-               "                   [--tile NX,NY,NZ]\n",
+               "                   [--export-lammps FILE] [--no-energy] [--skin METRES|settled] [--order file|morton|shuffled]\n"
+               "                   [--tile NX,NY,NZ] [--warmup STEPS]\n",
                msg);
   std::exit(2);
 }
@@ -106,7 +110,9 @@ Options parse(int argc, char** argv) {
       o.warmup = std::atol(value().c_str());
       if (o.warmup < 0) usage("--warmup takes a number of steps >= 0");
     } else if (a == "--skin") {
-      o.skin = std::atof(value().c_str());
+      const std::string v = value();
+      if (v == "settled") o.settledSkin = true;
+      else o.skin = std::atof(v.c_str());
     } else if (a == "--tile") {
       std::stringstream s(value());
       std::string t;
@@ -285,8 +291,9 @@ double median(std::vector<double> v) {
 
 int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress lines appear at once when piped (tee)
-  const Options o = parse(argc, argv);
+  Options o = parse(argc, argv);
   Simulation prepared = loadOrPrepare(o.cache);
+  if (o.settledSkin) o.skin = settledSkin(prepared, o);
   const std::size_t n = prepared.particles().size() * static_cast<std::size_t>(o.tile[0] * o.tile[1] * o.tile[2]);
 
   {

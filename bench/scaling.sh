@@ -8,8 +8,8 @@
 # best runs is printed too: the host's noise only ever slows a run. Each round runs 4k before every larger size
 # (4k 32k 4k 256k 4k 1M, and one 4k run after the last round), so each larger run also has a paired ratio: its
 # time over the mean of the 4k runs just before and after it, which cancels the host's slower drifts; the
-# column "paired" gives their median and range. Every run first takes 128 untimed steps (bench_dense --warmup):
-# the automatic skin narrows at its list's 64th step, and the 1M-sphere run has only ~100 timed steps.
+# column "paired" gives their median and range. Every run uses the skin the automatic skin settles to on the
+# 4000-sphere packing (bench_dense --skin settled): the 1M-sphere run has only ~100 steps, too few to settle.
 # Usage: bench/scaling.sh [--build DIR] [--threads 1,2] [--particle-steps 2e8] [--rounds 3]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -41,7 +41,7 @@ run_size() {
   steps="$(run_steps "$psteps" "$n" 100)"
   seq=$((seq + 1))
   (cd "$root" && "$bench" --cache "$cache" --tile "$1" --threads "$threads" --steps "$steps" \
-    --warmup 128 --repeats 1) >"$out/$n.txt" 2>&1 || { tail -20 "$out/$n.txt"; exit 1; }
+    --skin settled --repeats 1) >"$out/$n.txt" 2>&1 || { tail -20 "$out/$n.txt"; exit 1; }
   sed -n "s/^result: threads=\([0-9]*\) rate=\([^ ]*\) ns_per_particle_step=\([^ ]*\) N=[0-9]* bytes_per_particle=\([^ ]*\).*/$seq $n \1 \2 \3 \4/p" \
     "$out/$n.txt" | tee -a "$out/runs.txt" | awk -v r="$2" '{printf "round %d: N=%s threads=%s %s ns/p-step\n", r, $2, $3, $5}'
 }

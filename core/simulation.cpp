@@ -144,8 +144,8 @@ void Simulation::forcesAndControl() {
   // the displacements need; its new skin follows them (verlet_skin.hpp)
   const double used = displacementBound();
   const bool automatic = !(m_num.skin > 0.0);
-  if (used > m_skin || (automatic && verlet_skin::tooWide(m_skin, used, m_listSteps, m_meanDiameter))) {
-    setSkin(automatic ? verlet_skin::optimal(used, m_listSteps, m_meanDiameter) : m_num.skin);
+  if (used > m_skin || (automatic && verlet_skin::tooWide(listStats(used), m_meanDiameter))) {
+    setSkin(automatic ? verlet_skin::optimal(listStats(used), m_meanDiameter) : m_num.skin);
     rebuildNeighbours();
     ++m_profile.rebuilds;
   }
@@ -266,6 +266,12 @@ double Simulation::displacementBound() const {
   // ||F - I|| * |l| (homogeneous cell strain since the rebuild, F = H H_ref^-1, |l| <= cut-off).
   const Mat3 strain = m_cell.matrix() * m_refHinv - Mat3::Identity();
   return 2.0 * std::sqrt(m_maxDisp2) + strain.norm() * m_cutoff;
+}
+
+verlet_skin::ListStats Simulation::listStats(double used) const {
+  // the contacts of the last pass (m_diag.contacts) among the listed pairs: the rest are the list's gaps
+  const double gaps = static_cast<double>(m_c.size()) - static_cast<double>(std::min(m_diag.contacts, m_c.size()));
+  return {m_skin, m_listSteps, used, gaps / static_cast<double>(m_p.size())};
 }
 
 void Simulation::setSkin(double skin) {

@@ -31,6 +31,7 @@
 #include "energy_ledger.hpp"
 #include "material.hpp"
 #include "numerics.hpp"
+#include "verlet_skin.hpp"
 #include "particle_store.hpp"
 #include "periodic_cell.hpp"
 #include "thread_boundary.hpp"
@@ -168,6 +169,7 @@ class Simulation {
   void drift();
   double displacementBound() const;  // how far the gap of a pair may have shrunk since the last rebuild [m]
   void setSkin(double skin);  // the next list's skin, and its cut-off
+  verlet_skin::ListStats listStats(double used) const;  // what the automatic skin reads of the current list
   static double meanDiameter(const ParticleStore& p);
   void forcesAndControl();  // neighbours, contacts, the clock and the controller
   void rebuildNeighbours();

@@ -1,17 +1,22 @@
 // The automatic Verlet skin (numerics.skin = 0; issue 6: "a skin tuned to rebuild rarely").
 // A list with skin s holds every pair within s of contact. It is rebuilt when the displacement bound of
-// Simulation::displacementBound, u(n) = 2 max|Δx| + ||F - I|| l_cut after n steps, exceeds s. The per-step cost of a
-// skin is the list's pairs that do not touch: each is read, tested and gathered every step (~7 ns a pair on the
-// dense 4000-sphere benchmark, ~10 % of a particle-step), and their number grows about linearly with s. A
-// rebuild costs R steps (R ≈ 10 on that benchmark, 1 thread) once every s / ů steps, ů = u(n)/n the rate at
-// which the bound grows. Cost per step, in steps: R ů / s + c g s, with g the non-touching pairs per particle
-// per mean diameter d of skin (~20–36 in dense packings) and c their cost in particle-steps (~0.1); the
-// minimum is at s* = sqrt(κ d ů), κ = R / (c g d) ≈ 3–5 steps. The cost ratio depends weakly on the machine
-// and the packing; the optimum is flat (a factor 2 in s costs ~25 % more overhead than s*).
+// Simulation::displacementBound, u(n) = 2 max|Δx| + ||F - I|| l_cut after n steps, exceeds s. Two costs pull s
+// apart:
+//   - the listed pairs that do not touch: each is read, tested and gathered every step (~7 ns a pair on the
+//     dense 4000-sphere benchmark, ~10 % of a particle-step); there are g s of them per particle, g [1/m] the
+//     density of gaps below s (a dense packing's near-contact peak: g ≈ 36 per mean diameter d at s = 0.01 d,
+//     a loose gas's ≈ 24 φ/d, ten times fewer);
+//   - the rebuilds: one costs as much per particle as ρ such pairs for one step (ρ ≈ 100 measured on the dense
+//     benchmark, 0.75 µs a particle against 7.3 ns a pair; 150 here for what follows a rebuild: fresh arrays,
+//     cold caches, the threads' shares made again), once every s / ů steps, ů = u(n)/n.
+// Per step and particle, in pair-steps: ρ ů / s + g s; the minimum is at s* = sqrt(ρ ů / g). g is read off the
+// list being replaced, (listed − touching pairs) / (particles s): the packing's own density of gaps, so a gas
+// gets a wider skin than a dense packing moving as fast. The optimum is flat (a factor 2 in s costs 25 % more
+// overhead than s*).
 // Measured on the dense 4000-sphere benchmark (docs/performance.md, twenty-first session): the fixed skin of
-// 0.1 d left 5689 listed pairs that do not touch beside 11 722 contacts; a skin of 0.005 d, 881.
-// The rule is deterministic: it reads step counts and the displacement bound (a maximum: the same for any
-// thread count), never timings, so the list and the results do not depend on the machine's speed.
+// 0.1 d listed 5689 pairs that do not touch beside 11 722 contacts, the automatic one ~800.
+// The rule is deterministic: it reads step counts, pair counts and the displacement bound (a maximum: the same
+// for any thread count), never timings, so the list and the results do not depend on the machine's speed.
 #pragma once
 
 #include <algorithm>
@@ -23,16 +28,25 @@ constexpr double kMinFraction = 0.002;  // of the mean diameter: the smallest au
 constexpr double kMaxFraction = 0.1;    // the largest, and the first list's (the fixed default before issue 6's
                                         // twenty-first session: never a larger cut-off, so never a new
                                         // CellTooSmallError)
-constexpr double kCostRatio = 4.0;      // κ [steps], see above
+constexpr double kRebuildCost = 150.0;  // ρ: a rebuild's cost per particle in listed-pair steps, see above
 constexpr long kFirstCheck = 64;        // steps after a rebuild when a list may first be found too wide
 
-// The skin that minimises the cost per step for a bound that grew by `used` [m] in `steps` steps; clamped to
-// [kMinFraction, kMaxFraction] x meanDiameter. Without a step, the widest.
-inline double optimal(double used, long steps, double meanDiameter) {
+// What the rule reads of the list being replaced.
+struct ListStats {
+  double skin = 0.0;        // its skin [m]
+  long steps = 0;           // steps it lived
+  double used = 0.0;        // the displacement bound after them [m]
+  double gapPairs = 0.0;    // its listed pairs that did not touch at the last pass, per particle
+};
+
+// The skin that minimises the cost per step, clamped to [kMinFraction, kMaxFraction] x meanDiameter. Without a
+// step, or without a pair that does not touch (nothing to save), the widest.
+inline double optimal(const ListStats& list, double meanDiameter) {
   const double lo = kMinFraction * meanDiameter, hi = kMaxFraction * meanDiameter;
-  if (steps <= 0) return hi;
-  const double rate = std::max(0.0, used) / static_cast<double>(steps);  // ů [m per step]
-  return std::clamp(std::sqrt(kCostRatio * meanDiameter * rate), lo, hi);
+  if (list.steps <= 0 || !(list.gapPairs > 0.0) || !(list.skin > 0.0)) return hi;
+  const double rate = std::max(0.0, list.used) / static_cast<double>(list.steps);  // ů [m per step]
+  const double density = list.gapPairs / list.skin;                                // g [1/m]
+  return std::clamp(std::sqrt(kRebuildCost * rate / density), lo, hi);
 }
 
 // A list that has lived `steps` steps is checked for being too wide at 64, 128, 256, ... steps: a few times per
@@ -42,10 +56,10 @@ inline double optimal(double used, long steps, double meanDiameter) {
 // errs toward the wider skin; later checks narrow it further.
 inline bool isCheckStep(long steps) { return steps >= kFirstCheck && (steps & (steps - 1)) == 0; }
 
-// Whether a list of skin `skin` should be rebuilt narrower now: its optimum is less than half of it (a
-// rebuild costs ~10 steps; below a factor 2 the saving would not repay it soon).
-inline bool tooWide(double skin, double used, long steps, double meanDiameter) {
-  return isCheckStep(steps) && optimal(used, steps, meanDiameter) < 0.5 * skin;
+// Whether the list should be rebuilt narrower now: its optimum is less than half its skin (a rebuild costs
+// about ρ pair-steps a particle; below a factor 2 the saving would not repay it soon).
+inline bool tooWide(const ListStats& list, double meanDiameter) {
+  return isCheckStep(list.steps) && optimal(list, meanDiameter) < 0.5 * list.skin;
 }
 
 }  // namespace fl::verlet_skin

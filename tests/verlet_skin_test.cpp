@@ -16,18 +16,37 @@ namespace {
 
 constexpr double kD = 1.1e-3;  // a mean diameter [m]
 
-TEST(VerletSkinRule, OptimumIsTheSquareRootOfTheCostRatioTimesTheRate) {
-  // s* = sqrt(κ d ů), ů = used / steps: 20 µm in 2000 steps, d = 1.1 mm, κ = 4 → sqrt(4.4e-11) m = 6.6 µm
-  EXPECT_DOUBLE_EQ(verlet_skin::optimal(20e-6, 2000, kD), std::sqrt(4.0 * kD * 1e-8));
-  // four times the rate, twice the skin
-  EXPECT_DOUBLE_EQ(verlet_skin::optimal(80e-6, 2000, kD), 2.0 * verlet_skin::optimal(20e-6, 2000, kD));
+// A list of skin 0.1 d that lived 2000 steps, its bound grown by 20 µm, 1.42 gap pairs a particle (the dense
+// benchmark's at that skin).
+verlet_skin::ListStats aList() { return {0.1 * kD, 2000, 20e-6, 1.42}; }
+
+TEST(VerletSkinRule, OptimumIsTheSquareRootOfRebuildCostTimesRateOverGapDensity) {
+  // s* = sqrt(ρ ů / g): ů = 1e-8 m a step, g = 1.42 / 0.11 mm
+  const double g = 1.42 / (0.1 * kD);
+  EXPECT_DOUBLE_EQ(verlet_skin::optimal(aList(), kD), std::sqrt(verlet_skin::kRebuildCost * 1e-8 / g));
+  EXPECT_NEAR(verlet_skin::optimal(aList(), kD), 10.8e-6, 0.05e-6);
+  // four times the rate: twice the skin; four times the gaps (a denser packing): half
+  verlet_skin::ListStats faster = aList(), denser = aList();
+  faster.used *= 4.0;
+  denser.gapPairs *= 4.0;
+  EXPECT_DOUBLE_EQ(verlet_skin::optimal(faster, kD), 2.0 * verlet_skin::optimal(aList(), kD));
+  EXPECT_DOUBLE_EQ(verlet_skin::optimal(denser, kD), 0.5 * verlet_skin::optimal(aList(), kD));
+  // the same gaps on a list half as wide are a density twice as high
+  verlet_skin::ListStats narrower = aList();
+  narrower.skin *= 0.5;
+  EXPECT_DOUBLE_EQ(verlet_skin::optimal(narrower, kD), std::sqrt(0.5) * verlet_skin::optimal(aList(), kD));
 }
 
 TEST(VerletSkinRule, ClampedToItsRangeOfTheMeanDiameter) {
-  EXPECT_DOUBLE_EQ(verlet_skin::optimal(0.0, 5000, kD), verlet_skin::kMinFraction * kD);    // nothing moved
-  EXPECT_DOUBLE_EQ(verlet_skin::optimal(1e-3, 10, kD), verlet_skin::kMaxFraction * kD);     // a gas
-  EXPECT_DOUBLE_EQ(verlet_skin::optimal(1e-6, 0, kD), verlet_skin::kMaxFraction * kD);      // no step: widest
-  EXPECT_DOUBLE_EQ(verlet_skin::optimal(-1.0, 100, kD), verlet_skin::kMinFraction * kD);    // never below
+  verlet_skin::ListStats still = aList(), gas = aList(), fresh = aList(), noGaps = aList();
+  still.used = 0.0;       // nothing moved
+  gas.used = 1e-2;        // everything moved far
+  fresh.steps = 0;        // no step
+  noGaps.gapPairs = 0.0;  // every listed pair touches: nothing to save
+  EXPECT_DOUBLE_EQ(verlet_skin::optimal(still, kD), verlet_skin::kMinFraction * kD);
+  EXPECT_DOUBLE_EQ(verlet_skin::optimal(gas, kD), verlet_skin::kMaxFraction * kD);
+  EXPECT_DOUBLE_EQ(verlet_skin::optimal(fresh, kD), verlet_skin::kMaxFraction * kD);
+  EXPECT_DOUBLE_EQ(verlet_skin::optimal(noGaps, kD), verlet_skin::kMaxFraction * kD);
 }
 
 TEST(VerletSkinRule, ChecksAtPowersOfTwoFrom64StepsAndOnlyForAFactorTwo) {
@@ -40,11 +59,25 @@ TEST(VerletSkinRule, ChecksAtPowersOfTwoFrom64StepsAndOnlyForAFactorTwo) {
   EXPECT_FALSE(verlet_skin::isCheckStep(1536));
   EXPECT_TRUE(verlet_skin::isCheckStep(2048));
   EXPECT_TRUE(verlet_skin::isCheckStep(1L << 20));
-  const double s = verlet_skin::optimal(2e-6, 1024, kD);
-  EXPECT_TRUE(verlet_skin::tooWide(2.01 * s, 2e-6, 1024, kD));
-  EXPECT_FALSE(verlet_skin::tooWide(1.99 * s, 2e-6, 1024, kD));
-  EXPECT_FALSE(verlet_skin::tooWide(10.0 * s, 2e-6, 1025, kD));  // not a check step
-  EXPECT_FALSE(verlet_skin::tooWide(10.0 * s, 2e-6, 32, kD));
+  // ů = 1e-8 m a step, 1.42 gap pairs a particle: a 20 µm list's optimum is sqrt(ρ ů 20 µm / 1.42) = 4.6 µm,
+  // less than half of it; a 4 µm list's is 2.1 µm, clamped to 0.002 d = 2.2 µm: more than half
+  verlet_skin::ListStats list = aList();
+  list.steps = 2048;
+  list.used = 2048 * 1e-8;
+  list.skin = 20e-6;
+  EXPECT_NEAR(verlet_skin::optimal(list, kD), 4.6e-6, 0.05e-6);
+  EXPECT_TRUE(verlet_skin::tooWide(list, kD));
+  list.steps = 2049;  // not a check step
+  list.used = 2049 * 1e-8;
+  EXPECT_FALSE(verlet_skin::tooWide(list, kD));
+  list.steps = 32;
+  list.used = 32 * 1e-8;
+  EXPECT_FALSE(verlet_skin::tooWide(list, kD));
+  list.steps = 2048;
+  list.used = 2048 * 1e-8;
+  list.skin = 4e-6;
+  EXPECT_DOUBLE_EQ(verlet_skin::optimal(list, kD), verlet_skin::kMinFraction * kD);
+  EXPECT_FALSE(verlet_skin::tooWide(list, kD));
 }
 
 // Touching pairs by brute force (a search with skin 0) against the list's contacts.
