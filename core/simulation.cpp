@@ -10,7 +10,6 @@
 
 #include "errors.hpp"
 #include "neighbor_search.hpp"
-#include "verlet_skin.hpp"
 
 namespace fl {
 

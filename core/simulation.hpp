@@ -31,10 +31,10 @@
 #include "energy_ledger.hpp"
 #include "material.hpp"
 #include "numerics.hpp"
-#include "verlet_skin.hpp"
 #include "particle_store.hpp"
 #include "periodic_cell.hpp"
 #include "thread_boundary.hpp"
+#include "verlet_skin.hpp"
 #include "work_stealing.hpp"
 
 namespace fl {
