@@ -14,12 +14,8 @@
 //
 //   bench_dense [--threads 1,2] [--steps 20000] [--repeats 5] [--cache FILE] [--export-lammps FILE]
 //               [--no-energy] [--skin METRES|settled] [--order file|morton|shuffled] [--tile NX,NY,NZ]
-//               [--warmup STEPS]
 // --skin settled fixes the skin at the one the automatic skin settles to on the untiled packing (settledSkin):
 // every size of bench/scaling.sh then runs on the same list, whatever its number of steps.
-// --warmup runs that many steps of each repeat before its timed steps (and its profile): the automatic skin
-// (core/verlet_skin.hpp) narrows at the list's 64th step, so runs of a few hundred steps (1M spheres in
-// bench/scaling.sh) are timed on the settled list.
 // --tile replicates the periodic packing NX x NY x NZ times (same density, stress and contacts per particle:
 // the scaling measurement of issue 6 uses 1,1,1 / 2,2,2 / 4,4,4 / 6,6,7 = 4k, 32k, 256k, 1M spheres).
 #include <algorithm>
@@ -59,7 +55,6 @@ constexpr double kDt = 1e-7;               // [s]
 struct Options {
   std::vector<int> threads{1, 2};
   long steps = 20000;
-  long warmup = 0;  // untimed steps before each repeat's timed ones
   int repeats = 5;
   std::string cache = "build/bench-cache/dense4000_318kPa.state";
   std::string exportLammps;
@@ -76,7 +71,7 @@ struct Options {
   std::fprintf(stderr,
                "bench_dense: %s\nusage: bench_dense [--threads 1,2] [--steps N] [--repeats N] [--cache FILE]\n"
                "                   [--export-lammps FILE] [--no-energy] [--skin METRES|settled] [--order file|morton|shuffled]\n"
-               "                   [--tile NX,NY,NZ] [--warmup STEPS]\n",
+               "                   [--tile NX,NY,NZ]\n",
                msg);
   std::exit(2);
 }
@@ -106,9 +101,6 @@ Options parse(int argc, char** argv) {
       o.exportLammps = value();
     } else if (a == "--no-energy") {
       o.trackEnergy = false;
-    } else if (a == "--warmup") {
-      o.warmup = std::atol(value().c_str());
-      if (o.warmup < 0) usage("--warmup takes a number of steps >= 0");
     } else if (a == "--skin") {
       const std::string v = value();
       if (v == "settled") o.settledSkin = true;
@@ -339,10 +331,6 @@ int main(int argc, char** argv) {
     std::vector<StageProfile> profiles;
     for (int r = 0; r < o.repeats; ++r) {
       Simulation sim = measuredScene(prepared, t, o);
-      if (o.warmup > 0) {
-        sim.run(o.warmup);
-        sim.resetProfile();
-      }
       const auto t0 = std::chrono::steady_clock::now();
       sim.run(o.steps);
       const double s = seconds(t0);

@@ -141,10 +141,10 @@ void Simulation::forcesAndControl() {
   ++m_listSteps;
   // the list is rebuilt when a pair outside it may touch, or (automatic skin) when it is found much wider than
   // the displacements need; its new skin follows them (verlet_skin.hpp)
-  const double used = displacementBound();
+  const verlet_skin::ListStats list = listStats(displacementBound());
   const bool automatic = !(m_num.skin > 0.0);
-  if (used > m_skin || (automatic && verlet_skin::tooWide(listStats(used), m_meanDiameter))) {
-    setSkin(automatic ? verlet_skin::optimal(listStats(used), m_meanDiameter) : m_num.skin);
+  if (list.used > m_skin || (automatic && verlet_skin::tooWide(list, m_meanDiameter))) {
+    setSkin(automatic ? verlet_skin::optimal(list, m_meanDiameter) : m_num.skin);
     rebuildNeighbours();
     ++m_profile.rebuilds;
   }

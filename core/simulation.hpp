@@ -126,7 +126,6 @@ class Simulation {
   // contacts (or the pass summed them itself): a step that nobody measured leaves it false
   bool contactsMeasured() const { return m_contactsMeasured; }
   const StageProfile& profile() const { return m_profile; }
-  void resetProfile() { m_profile = StageProfile{}; }  // e.g. after a benchmark's untimed warm-up
   // The threads' shares and what crosses between them, as the last parallel step made them (thread_boundary.hpp)
   const ThreadBoundary& threadBoundary() const { return m_boundary; }
   // Heap bytes held by the state (particle and pair arrays by capacity, history, adjacency, reduction
