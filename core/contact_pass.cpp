@@ -109,6 +109,7 @@ void Simulation::contactPassBlocked() {
   // history back and sum the chunk's partials in pair order.
   static_assert(kChunk % kernels::kBlockPairs == 0, "reduction chunks hold whole blocks");
   static_assert(kernels::kBlockPairs == 64, "a block's touching pairs are one word of ContactStore::touched");
+  static_assert(ThreadBoundary::kHaloBlock == kernels::kBlockPairs, "a block's halo pairs are one word");
   if (!m_c.touchedValid) m_c.markTouched();  // after a rebuild, a restore or the other law's pass
   std::uint64_t* touched = m_c.touched.data();
   const PassArrays arr(m_pass, m_p, m_c, m_cell, m_dt);
@@ -170,9 +171,13 @@ void Simulation::contactPassBlocked() {
     const auto ownFrom = static_cast<std::uint32_t>(own ? m_boundary.begin[t] : staticBegin(t, nt, arr.n));
     const auto ownTo = static_cast<std::uint32_t>(own ? m_boundary.begin[t + 1] : staticBegin(t + 1, nt, arr.n));
     const std::uint32_t ownSpan = all ? 0 : ownTo - ownFrom;  // every partner lies outside an empty span
+    const std::uint64_t* haloPairs = tb.haloPairs.data();  // exchange: the pairs that read a halo slot
     ThreadRuns runs(m_ranges, t, nt, nchunks);  // the chunks this thread computes, run by run
     for (std::size_t runBegin, runEnd; runs.next(runBegin, runEnd);)
     for (std::size_t k = runBegin; k < runEnd; ++k) {
+      // in a chunk of its own share the partners this thread did not drift are exactly the halo slots, which
+      // their block's word lists; in a chunk taken from another share every partner is tested
+      const bool haloOnly = exchange && !all && k >= tb.chunkBegin[t] && k < tb.chunkBegin[t + 1];
       Chunk acc;
       kernels::BlockSums sums;
       const std::size_t chunkEnd = std::min(np, (k + 1) * kChunk);
@@ -182,7 +187,14 @@ void Simulation::contactPassBlocked() {
         // a line last written by the other core arrives 50-200 ns late, docs/performance.md), or all when the
         // state outgrows the caches (a whole sweep lies between a line's drift and its pass). At 4000 spheres
         // (3 MB) prefetching every partner cost ~15 % of a 1-thread step.
-        if (remote)
+        if (haloOnly) {
+          if (p1 < np)
+            for (std::uint64_t w = haloPairs[p1 / kernels::kBlockPairs]; w != 0; w &= w - 1) {
+              const std::int32_t jn = partner[p1 + static_cast<std::size_t>(__builtin_ctzll(w))];
+              __builtin_prefetch(&passOf(jn));
+              __builtin_prefetch(&omegaOf(jn));
+            }
+        } else if (remote)
           for (std::size_t q = p1, qEnd = std::min(np, p1 + kernels::kBlockPairs); q < qEnd; ++q) {
             const std::int32_t jn = partner[q];
             if (static_cast<std::uint32_t>(jn) - ownFrom >= ownSpan) {  // a halo slot lies outside too

@@ -435,6 +435,7 @@ void Simulation::kickPass(const DriftPlan* plan) {
   const bool seeded = kSeeded && seedsReady && threads == tb.threads;
   const std::int32_t* kickBegin = tb.kickBegin.data();
   const std::int32_t* seedOf = tb.seedOf.data();
+  const std::int32_t* seededList = tb.seeded.data();  // the seeded particles, ascending (when seeded)
   // result lines to prefetch (kPrefetchEntries): all when the state outgrows the caches, else those of the pairs
   // outside this thread's own share of the pass, which another thread most likely computed (with the seeds,
   // none: they carry those entries)
@@ -448,7 +449,12 @@ void Simulation::kickPass(const DriftPlan* plan) {
   const bool fetch = large || (threads > 1 && !seeded);
   const std::uint32_t ownSpan = large ? 0 : ownTo - ownFrom;  // every entry lies outside an empty span
   ThreadRuns runs(m_ranges, thread, threads, static_cast<std::size_t>(n));  // the particles this thread kicks, run by run
-  for (std::size_t begin, end; runs.next(begin, end);)
+  for (std::size_t begin, end; runs.next(begin, end);) {
+  // the next seeded particle from this run's first on (the list ends with an index past every particle)
+  std::size_t nextSeed = 0;
+  if (kSeeded && seeded)
+    nextSeed = static_cast<std::size_t>(
+        std::lower_bound(tb.seeded.begin(), tb.seeded.end(), static_cast<std::int32_t>(begin)) - tb.seeded.begin());
   for (std::size_t i = begin; i < end; ++i) {
     if (kDrift && thread > 0 && i + kPrefetchAhead < static_cast<std::size_t>(n))  // as the drift does
       __builtin_prefetch(pass + i + kPrefetchAhead, 1);
@@ -458,11 +464,14 @@ void Simulation::kickPass(const DriftPlan* plan) {
     // store-forwarding stall on the loop-carried torque (kick 5x slower).
     const double ri = rad[i];
     double fx = 0.0, fy = 0.0, fz = 0.0, tx = 0.0, ty = 0.0, tz = 0.0;
-    if (kSeeded && seeded) {  // slot 0: zero
+    std::int32_t firstEntry = adjStart[i];
+    if (kSeeded && seeded && static_cast<std::int32_t>(i) == seededList[nextSeed]) {
       const KickSeed& s0 = seeds[seedOf[i]];
       fx = s0.fx, fy = s0.fy, fz = s0.fz, tx = s0.tx, ty = s0.ty, tz = s0.tz;
+      firstEntry = kickBegin[i];
+      ++nextSeed;
     }
-    for (int e = kSeeded && seeded ? kickBegin[i] : adjStart[i]; e < adjStart[i + 1]; ++e) {
+    for (std::int32_t e = firstEntry; e < adjStart[i + 1]; ++e) {
       // the result line kPrefetchEntries entries ahead (about 16 particles), if it is not in this core's cache
       if (fetch && e + kPrefetchEntries < entries) {
         const auto ahead = static_cast<std::uint32_t>(adjEntry[e + kPrefetchEntries]);
@@ -497,6 +506,7 @@ void Simulation::kickPass(const DriftPlan* plan) {
     }
     w[i] = wi;
   }
+  }
   if constexpr (kLocalDamping) {
     // the work of each fixed chunk of particles, summed in particle order: the same bits for any split
 #pragma omp barrier
@@ -526,7 +536,7 @@ std::size_t Simulation::memoryBytes() const {
          b(c.history) + b(c.mdHistory) + b(c.result) + b(c.adjStart) + b(c.adjEntry) + b(m_refPos) +
          b(m_pass) + b(m_chunks) + b(m_kickWork) + b(m_haloPass) + b(m_haloW) + b(m_seeds) +
          b(m_boundary.partner) + b(m_boundary.halo) + b(m_boundary.seedParticle) + b(m_boundary.seedOf) +
-         b(m_boundary.kickBegin);
+         b(m_boundary.kickBegin) + b(m_boundary.seeded) + b(m_boundary.haloPairs);
 }
 
 // ---- measures -----------------------------------------------------------------------------------

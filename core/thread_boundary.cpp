@@ -2,6 +2,7 @@
 #include "thread_boundary.hpp"
 
 #include <algorithm>
+#include <limits>
 
 namespace fl {
 
@@ -84,6 +85,13 @@ ThreadBoundary buildThreadBoundary(const ContactStore& c, std::size_t particleCo
     }
   }
   b.seedBegin[nt] = b.seedParticle.size();
+  for (std::size_t i = 0; i < n; ++i)
+    if (b.seedOf[i] != 0) b.seeded.push_back(static_cast<std::int32_t>(i));
+  b.seeded.push_back(std::numeric_limits<std::int32_t>::max());
+  b.haloPairs.assign((np + ThreadBoundary::kHaloBlock - 1) / ThreadBoundary::kHaloBlock, 0);
+  for (std::size_t p = 0; p < np; ++p)
+    if (b.partner[p] >= static_cast<std::int32_t>(n))
+      b.haloPairs[p / ThreadBoundary::kHaloBlock] |= std::uint64_t{1} << (p % ThreadBoundary::kHaloBlock);
   return b;
 }
 

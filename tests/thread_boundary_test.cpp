@@ -87,6 +87,23 @@ void checkBoundary(const ContactStore& c, std::size_t n, int nt) {
   }
   EXPECT_GT(seeded, 0u);
   EXPECT_EQ(seeded + 1, b.seedParticle.size());
+  // the kick's list of seeded particles: every one, ascending, then an index past every particle
+  ASSERT_EQ(b.seeded.size(), seeded + 1);
+  for (std::size_t q = 0; q + 1 < b.seeded.size(); ++q) {
+    EXPECT_NE(b.seedOf[static_cast<std::size_t>(b.seeded[q])], 0) << "listed without a seed: " << b.seeded[q];
+    if (q > 0) {
+      EXPECT_LT(b.seeded[q - 1], b.seeded[q]);
+    }
+  }
+  EXPECT_GE(b.seeded.back(), static_cast<std::int32_t>(n));
+  // the pass's words of halo pairs: bit p of block p / 64 set exactly where pair p reads a halo slot
+  ASSERT_EQ(b.haloPairs.size(), (c.size() + ThreadBoundary::kHaloBlock - 1) / ThreadBoundary::kHaloBlock);
+  for (std::size_t p = 0; p < c.size(); ++p) {
+    const bool bit = (b.haloPairs[p / ThreadBoundary::kHaloBlock] >> (p % ThreadBoundary::kHaloBlock)) & 1u;
+    EXPECT_EQ(bit, b.partner[p] >= static_cast<std::int32_t>(n)) << "pair " << p;
+  }
+  for (std::size_t p = c.size(); p < b.haloPairs.size() * ThreadBoundary::kHaloBlock; ++p)
+    EXPECT_EQ((b.haloPairs.back() >> (p % ThreadBoundary::kHaloBlock)) & 1u, 0u) << "a bit past the last pair";
   // with two shares only the first particle of the second share can keep foreign entries unseeded (its
   // own pairs straddle the split): at most its entries
   if (nt == 2) {
