@@ -173,7 +173,38 @@ void Simulation::contactPassBlocked() {
     const std::uint32_t ownSpan = all ? 0 : ownTo - ownFrom;  // every partner lies outside an empty span
     const std::uint64_t* haloPairs = tb.haloPairs.data();  // exchange: the pairs that read a halo slot
     ThreadRuns runs(m_ranges, t, nt, nchunks);  // the chunks this thread computes, run by run
-    for (std::size_t runBegin, runEnd; runs.next(runBegin, runEnd);)
+    // Its own share's runs, then (StealingRanges::nextOwn) the seeds this thread owes: the leading adjacency
+    // entries of other threads' particles that its share of the chunks holds, summed as soon as the whole share
+    // is computed (with the runs another thread took from it: waitForTakers) and before it takes runs of another
+    // share, so the other threads go on meanwhile (after a barrier, the other thread waited for them); then runs
+    // taken from the share before it, each reported done when the next is claimed.
+    bool taking = false;
+    std::size_t takenItems = 0;
+    const auto nextRun = [&](std::size_t& runBegin, std::size_t& runEnd) {
+      if (takenItems != 0) runs.doneTaken(takenItems);
+      takenItems = 0;
+      if (!taking) {
+        if (runs.nextOwn(runBegin, runEnd)) return true;
+        taking = true;
+        if (exchange) {
+          runs.waitForTakers();
+          for (std::size_t q = tb.seedBegin[t]; q < tb.seedBegin[t + 1]; ++q) {
+            const std::int32_t i = tb.seedParticle[q];
+            const double ri = m_p.radius[i];  // not pass[i]: its owner's line
+            double fx = 0.0, fy = 0.0, fz = 0.0, tx = 0.0, ty = 0.0, tz = 0.0;
+            for (std::int32_t e = m_c.adjStart[i]; e < tb.kickBegin[i]; ++e) {
+              const std::int32_t entry = m_c.adjEntry[e];
+              kickEntry(arr.result[entry >> 1], entry, ri, fx, fy, fz, tx, ty, tz);
+            }
+            seeds[q] = {fx, fy, fz, tx, ty, tz};
+          }
+        }
+      }
+      if (!runs.nextTaken(runBegin, runEnd)) return false;
+      takenItems = runEnd - runBegin;
+      return true;
+    };
+    for (std::size_t runBegin, runEnd; nextRun(runBegin, runEnd);)
     for (std::size_t k = runBegin; k < runEnd; ++k) {
       // in a chunk of its own share the partners this thread did not drift are exactly the halo slots, which
       // their block's word lists; in a chunk taken from another share every partner is tested
@@ -287,21 +318,6 @@ void Simulation::contactPassBlocked() {
       chunks[k] = acc;
     }
     if (stream) streamFence();  // the kick's threads read these lines after the region's barrier
-    // the seeds this thread owes: the leading adjacency entries of other threads' particles that its share of
-    // the chunks holds, summed once every thread is done (a run of that share may have been stolen)
-    if (exchange) {
-#pragma omp barrier
-      for (std::size_t q = tb.seedBegin[t]; q < tb.seedBegin[t + 1]; ++q) {
-        const std::int32_t i = tb.seedParticle[q];
-        const double ri = m_p.radius[i];  // not pass[i]: its owner's line
-        double fx = 0.0, fy = 0.0, fz = 0.0, tx = 0.0, ty = 0.0, tz = 0.0;
-        for (std::int32_t e = m_c.adjStart[i]; e < tb.kickBegin[i]; ++e) {
-          const std::int32_t entry = m_c.adjEntry[e];
-          kickEntry(arr.result[entry >> 1], entry, ri, fx, fy, fz, tx, ty, tz);
-        }
-        seeds[q] = {fx, fy, fz, tx, ty, tz};
-      }
-    }
   }
   m_seedsReady = kHalo && team == tb.threads && tb.exchange;
   m_profile.stolenRuns += static_cast<long>(m_ranges.stolen());

@@ -24,6 +24,8 @@ void StealingRanges::reset(const std::vector<std::size_t>& bounds, std::size_t g
   for (int t = 0; t < nt; ++t) {
     m_shares[t].bounds.store(pack(bounds[t], bounds[t + 1]), std::memory_order_relaxed);
     m_shares[t].stolen.store(0, std::memory_order_relaxed);
+    m_shares[t].end = static_cast<std::uint32_t>(bounds[t + 1]);
+    m_shares[t].takenDone.store(0, std::memory_order_relaxed);
   }
 }
 
@@ -61,9 +63,33 @@ bool StealingRanges::claimBack(Share& s, std::size_t& begin, std::size_t& end) c
 }
 
 bool StealingRanges::next(int t, std::size_t& begin, std::size_t& end) {
-  if (claimFront(m_shares[t], begin, end)) return true;
-  if (m_threads < 2) return false;
-  return claimBack(m_shares[(t + m_threads - 1) % m_threads], begin, end);
+  return nextOwn(t, begin, end) || nextTaken(t, begin, end);
+}
+
+bool StealingRanges::nextOwn(int t, std::size_t& begin, std::size_t& end) {
+  return claimFront(m_shares[t], begin, end);
+}
+
+bool StealingRanges::nextTaken(int t, std::size_t& begin, std::size_t& end) {
+  return m_threads >= 2 && claimBack(m_shares[victimOf(t)], begin, end);
+}
+
+void StealingRanges::doneTaken(int t, std::size_t items) {
+  // release: the run's writes are visible to the owner that sees the count (waitForTakers)
+  m_shares[victimOf(t)].takenDone.fetch_add(items, std::memory_order_release);
+}
+
+void StealingRanges::waitForTakers(int t) const {
+  const Share& s = m_shares[t];
+  // once the share is empty (front >= back) no run can be taken any more: the taken items are [back, end)
+  const std::uint64_t w = s.bounds.load(std::memory_order_relaxed);
+  assert(frontOf(w) >= backOf(w));
+  const std::uint64_t taken = s.end - backOf(w);
+  while (s.takenDone.load(std::memory_order_acquire) < taken) {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+  }
 }
 
 }  // namespace fl

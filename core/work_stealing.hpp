@@ -39,6 +39,15 @@ class StealingRanges {
   // In the region, thread t: its next run [begin, end), from its own share's front, else from the back of the
   // share before it; false when both are empty (the thread is done with this loop).
   bool next(int t, std::size_t& begin, std::size_t& end);
+  // The same two sources one at a time, for a loop that has work of its own between them (the contact pass's
+  // seeds): its own share's front, then the back of the share before it. A thread that takes a run with
+  // nextTaken reports it done with doneTaken once its items are written; the owner of a share, once nextOwn
+  // has found it empty, may then wait for those runs (waitForTakers) and read what they wrote. Waits cannot
+  // form a cycle: a thread takes runs only after its own wait.
+  bool nextOwn(int t, std::size_t& begin, std::size_t& end);
+  bool nextTaken(int t, std::size_t& begin, std::size_t& end);
+  void doneTaken(int t, std::size_t items);
+  void waitForTakers(int t) const;
   int threads() const { return m_threads; }
   // Serial, after the region: runs taken from another thread's share since the last reset.
   std::size_t stolen() const;
@@ -48,7 +57,10 @@ class StealingRanges {
   struct alignas(64) Share {
     std::atomic<std::uint64_t> bounds{0};
     std::atomic<std::uint32_t> stolen{0};  // runs taken from its back, on the line the thief just took
+    std::uint32_t end = 0;                 // the share's back at reset: the items taken are [back, end)
+    std::atomic<std::uint64_t> takenDone{0};  // items of the runs taken that their thief has finished
   };
+  int victimOf(int t) const { return (t + m_threads - 1) % m_threads; }
   bool claimFront(Share& s, std::size_t& begin, std::size_t& end) const;
   bool claimBack(Share& s, std::size_t& begin, std::size_t& end) const;
 
@@ -67,13 +79,28 @@ class ThreadRuns {
         m_begin(staticBegin(t, nt, count)), m_end(staticBegin(t + 1, nt, count)) {}
   bool next(std::size_t& begin, std::size_t& end) {
     if (m_ranges) return m_ranges->next(m_t, begin, end);
+    return nextStatic(begin, end);
+  }
+  // in two phases (StealingRanges::nextOwn): the static share has nothing to take and nobody to wait for
+  bool nextOwn(std::size_t& begin, std::size_t& end) {
+    if (m_ranges) return m_ranges->nextOwn(m_t, begin, end);
+    return nextStatic(begin, end);
+  }
+  bool nextTaken(std::size_t& begin, std::size_t& end) { return m_ranges && m_ranges->nextTaken(m_t, begin, end); }
+  void doneTaken(std::size_t items) {
+    if (m_ranges) m_ranges->doneTaken(m_t, items);
+  }
+  void waitForTakers() const {
+    if (m_ranges) m_ranges->waitForTakers(m_t);
+  }
+
+ private:
+  bool nextStatic(std::size_t& begin, std::size_t& end) {
     if (m_begin >= m_end) return false;
     begin = m_begin, end = m_end;
     m_begin = m_end;
     return true;
   }
-
- private:
   StealingRanges* m_ranges;
   int m_t;
   std::size_t m_begin, m_end;

@@ -141,3 +141,61 @@ TEST(WorkStealing, EveryItemIsTakenOnceUnderContention) {
   }
   EXPECT_GT(stolen, 0) << "the random pauses should have left some runs to be stolen";
 }
+
+// The two-phase claims (nextOwn, then nextTaken with doneTaken) of the contact pass, which sums its seeds from
+// its whole share between them: once waitForTakers returns, every item of the owner's share has been written,
+// by the owner or by the thread that took it, and each item exactly once. Thieves are slowed at random, and
+// write their items with plain stores, so a wait that returned early would read a zero (and TSan, in the
+// sanitizer pass, would report the race). Checked by hand: without the wait, the owners read unwritten items.
+TEST(WorkStealing, AnOwnerWaitsForTheRunsTakenFromItsShare) {
+  constexpr int kThreads = 3;
+  constexpr std::size_t kItems = 600;
+  StealingRanges r;
+  std::vector<std::size_t> bounds(kThreads + 1);
+  for (int t = 0; t <= kThreads; ++t) bounds[t] = staticBegin(t, kThreads, kItems);
+  long takenRuns = 0;
+  for (int loop = 0; loop < 40; ++loop) {
+    r.reset(bounds, 1 + static_cast<std::size_t>(loop % 5));
+    std::vector<int> value(kItems, 0);
+    std::vector<long> seen(kThreads, 0), taken(kThreads, 0);
+    std::vector<std::thread> team;
+    for (int t = 0; t < kThreads; ++t)
+      team.emplace_back([&, t] {
+        std::mt19937 rng(static_cast<unsigned>(loop * kThreads + t));
+        ThreadRuns claims(r, t, kThreads, kItems);
+        std::size_t b = 0, e = 0;
+        while (claims.nextOwn(b, e)) {
+          // the owner of share 0 is slow, so the others finish first and take its runs
+          if (t == 0) std::this_thread::sleep_for(std::chrono::microseconds(20 + rng() % 40));
+          for (std::size_t i = b; i < e; ++i) value[i] = 1;
+        }
+        claims.waitForTakers();
+        for (std::size_t i = bounds[t]; i < bounds[t + 1]; ++i) seen[t] += value[i];
+        while (claims.nextTaken(b, e)) {
+          std::this_thread::sleep_for(std::chrono::microseconds(rng() % 60));
+          for (std::size_t i = b; i < e; ++i) value[i] = 1;
+          claims.doneTaken(e - b);
+          ++taken[t];
+        }
+      });
+    for (std::thread& th : team) th.join();
+    for (int t = 0; t < kThreads; ++t)
+      EXPECT_EQ(seen[t], static_cast<long>(bounds[t + 1] - bounds[t])) << "loop " << loop << ", share " << t;
+    for (long k : taken) takenRuns += k;
+  }
+  EXPECT_GT(takenRuns, 0) << "the slow owner should have had runs taken";
+}
+
+// One thread, or a team of another size: nextOwn gives the static share whole, nothing is taken, nobody waits.
+TEST(WorkStealing, TwoPhaseClaimsOfAStaticShare) {
+  StealingRanges r;
+  r.reset({0, 5, 10}, 2);
+  ThreadRuns claims(r, 1, 3, 9);  // a team of 3 against ranges for 2: static
+  std::size_t b = 0, e = 0;
+  ASSERT_TRUE(claims.nextOwn(b, e));
+  EXPECT_EQ(b, 3u);
+  EXPECT_EQ(e, 6u);
+  EXPECT_FALSE(claims.nextOwn(b, e));
+  claims.waitForTakers();
+  EXPECT_FALSE(claims.nextTaken(b, e));
+}
