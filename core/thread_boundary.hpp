@@ -10,8 +10,9 @@
 //  - seeds: when a particle's first adjacency entries are pairs that one other thread computed, that thread
 //    sums them after its pass, in the kick's order and with the kick's operations (kickEntry), into a seed;
 //    the owner's kick starts from the seed and reads the rest itself (at 4000 spheres ~500 seeds against
-//    ~1300 result lines the other core wrote). The thread that owes a seed sums it after every thread's pass
-//    (a barrier): with work stealing another thread may have computed some of its pairs.
+//    ~1300 result lines the other core wrote). The thread that owes a seed sums it once its own share of the
+//    pass is done, runs another thread took from it included (StealingRanges::waitForTakers), before it takes
+//    runs of another share; the kick walks the list of seeded particles (seeded) beside its own.
 // On hosts that put the two vCPUs on far cores (~170 ns a line) this made 2 threads 1.34-1.36x faster than the
 // shared lines read in place under work stealing (1.4-1.5x with a static split); near (~30 ns) it is level.
 // Halo slots are copies and seeds are the kick's own partial sums, so the bits do not depend on the split.
