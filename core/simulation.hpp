@@ -282,6 +282,8 @@ class Simulation {
   std::vector<PassParticle> m_haloPass;  // halo slots: the pass copy and omega of other threads' partners
   std::vector<Vec3> m_haloW;
   std::vector<KickSeed> m_seeds;  // slot 0 stays zero
+  RoundProgress m_haloProgress;   // how many of its halo slots each thread has copied in this pass
+  static constexpr std::size_t kHaloBatch = 64;  // slots an owner copies between two publications
   bool m_seedsReady = false;      // the last pass summed the seeds for this team
   // inside run(), after a fused kick and drift: the particle store's x and v are behind the pass copy's (its
   // closing kick and rebuilds bring them back)

@@ -6,6 +6,7 @@
 // calls streamFence() before other threads may read what it streamed (before the end of a parallel region).
 #pragma once
 
+#include <cstddef>
 #include <cstring>
 
 #if defined(__SSE2__)
@@ -28,6 +29,22 @@ inline void streamLine(void* dst, const double* line) {
   for (int k = 0; k < 8; k += 2) _mm_stream_pd(d + k, _mm_loadu_pd(line + k));
 #else
   std::memcpy(d, line, 8 * sizeof(double));
+#endif
+}
+
+// Writes `words` 8-byte words from src to the 8-byte aligned dst by streaming stores (x86-64), for runs of
+// entries smaller than a line that the caller writes in ascending order, so that the write-combining buffer
+// still gathers whole lines; elsewhere a plain copy. The bits written are those of src either way.
+inline void streamWords(void* dst, const void* src, int words) {
+#if defined(__x86_64__)
+  auto* d = static_cast<long long*>(dst);
+  for (int k = 0; k < words; ++k) {
+    long long w;
+    std::memcpy(&w, static_cast<const char*>(src) + 8 * k, sizeof w);
+    _mm_stream_si64(d + k, w);
+  }
+#else
+  std::memcpy(dst, src, 8 * static_cast<std::size_t>(words));
 #endif
 }
 

@@ -41,24 +41,35 @@ ThreadBoundary buildThreadBoundary(const ContactStore& c, std::size_t particleCo
   const auto computedBy = [&](std::size_t p) { return passThread[p / chunk]; };
 
   // halo: the second particles that a pair's pass thread does not own (a first particle another thread owns
-  // is read in place: only the first particle of a share can be one, for a few pairs)
-  std::vector<char> inHalo(n, 0);
+  // is read in place: only the first particle of a share can be one, for a few pairs). Slots are grouped by
+  // owner, each group in the order of the pairs that first read them, so that the owner's copy fills them in the
+  // order the readers' passes need them.
+  std::vector<std::vector<std::int32_t>> group(nt);
+  std::vector<std::int32_t> slot(n, -1);  // first its place in its owner's group
+  for (std::size_t p = 0; p < np; ++p) {
+    const int j = c.second[p], o = owner[j];
+    if (o == computedBy(p) || slot[j] >= 0) continue;
+    slot[j] = static_cast<std::int32_t>(group[o].size());
+    group[o].push_back(j);
+  }
+  for (int t = 0; t < nt; ++t) {
+    b.haloBegin[t] = b.halo.size();
+    b.halo.insert(b.halo.end(), group[t].begin(), group[t].end());
+  }
+  b.haloBegin[nt] = b.halo.size();
+  const std::size_t blocks = (np + ThreadBoundary::kHaloBlock - 1) / ThreadBoundary::kHaloBlock;
+  b.haloPairs.assign(blocks, 0);
+  b.haloNeed.assign(blocks, 0);
   for (std::size_t p = 0; p < np; ++p) {
     const int j = c.second[p];
-    if (owner[j] != computedBy(p)) inHalo[j] = 1;
+    if (owner[j] == computedBy(p)) continue;
+    const std::size_t block = p / ThreadBoundary::kHaloBlock;
+    b.partner[p] = static_cast<std::int32_t>(n + b.haloBegin[owner[j]]) + slot[j];
+    b.haloPairs[block] |= std::uint64_t{1} << (p % ThreadBoundary::kHaloBlock);
+    b.haloNeed[block] = std::max(b.haloNeed[block], static_cast<std::uint32_t>(slot[j]) + 1);
   }
-  std::vector<std::int32_t> slot(n, -1);
-  for (std::size_t j = 0; j < n; ++j)
-    if (inHalo[j]) {
-      slot[j] = static_cast<std::int32_t>(b.halo.size());
-      b.halo.push_back(static_cast<std::int32_t>(j));
-      ++b.haloBegin[owner[j] + 1];
-    }
-  for (int t = 0; t < nt; ++t) b.haloBegin[t + 1] += b.haloBegin[t];
-  for (std::size_t p = 0; p < np; ++p) {
-    const int j = c.second[p];
-    if (owner[j] != computedBy(p)) b.partner[p] = static_cast<std::int32_t>(n) + slot[j];
-  }
+  // the pass prefetches the next block's halo slots while it computes this one
+  for (std::size_t k = 0; k + 1 < blocks; ++k) b.haloNeed[k] = std::max(b.haloNeed[k], b.haloNeed[k + 1]);
 
   // seeds: a particle whose leading adjacency entries were all computed by one other thread (entries are in
   // pair order, and a share's pairs come after those of the shares before it, so the foreign ones lead)
@@ -88,10 +99,6 @@ ThreadBoundary buildThreadBoundary(const ContactStore& c, std::size_t particleCo
   for (std::size_t i = 0; i < n; ++i)
     if (b.seedOf[i] != 0) b.seeded.push_back(static_cast<std::int32_t>(i));
   b.seeded.push_back(std::numeric_limits<std::int32_t>::max());
-  b.haloPairs.assign((np + ThreadBoundary::kHaloBlock - 1) / ThreadBoundary::kHaloBlock, 0);
-  for (std::size_t p = 0; p < np; ++p)
-    if (b.partner[p] >= static_cast<std::int32_t>(n))
-      b.haloPairs[p / ThreadBoundary::kHaloBlock] |= std::uint64_t{1} << (p % ThreadBoundary::kHaloBlock);
   return b;
 }
 

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <thread>
 
 namespace fl {
 
@@ -90,6 +91,39 @@ void StealingRanges::waitForTakers(int t) const {
     __builtin_ia32_pause();
 #endif
   }
+}
+
+std::uint64_t RoundProgress::beginRound(int threads, int cores) {
+  m_spins = threads > cores ? kSpinsOversubscribed : kSpins;
+  if (threads > m_capacity) {
+    m_slots = std::make_unique<Slot[]>(static_cast<std::size_t>(threads));  // every signal at round 0
+    m_capacity = threads;
+    m_round = 0;
+  }
+  if (++m_round == std::uint64_t{1} << 32) {  // after ~4e9 rounds: start again from round 1
+    for (int t = 0; t < m_capacity; ++t) m_slots[t].value.store(0, std::memory_order_relaxed);
+    m_round = 1;
+  }
+  return m_round;
+}
+
+std::uint32_t RoundProgress::waitFor(int s, std::uint64_t round, std::uint32_t done) const {
+  assert(s < m_capacity);
+  const std::uint64_t target = round << 32 | done;
+  // spin a while (the copy takes microseconds), then give the core away: with more threads than cores the
+  // owner may be waiting for this one's core (so then almost at once, as libgomp's barriers do)
+  std::uint64_t value;
+  for (int spins = 0; (value = m_slots[s].value.load(std::memory_order_acquire)) < target; ++spins) {
+    if (spins < m_spins) {
+#if defined(__x86_64__) || defined(__i386__)
+      __builtin_ia32_pause();
+#endif
+    } else {
+      std::this_thread::yield();
+    }
+  }
+  assert(value >> 32 == round);  // the owner publishes no later round before the region ends
+  return static_cast<std::uint32_t>(value);
 }
 
 }  // namespace fl

@@ -69,6 +69,33 @@ class StealingRanges {
   std::uint64_t m_grain = 1;
 };
 
+// Each thread's progress through its part of a round's shared input (the contact pass's halo slots,
+// thread_boundary.hpp): the owner publishes how many of its items it has written so far, and a reader waits
+// only until the items it is about to read are there, instead of every thread waiting at a barrier for the
+// whole copy. A value of an earlier round never satisfies a wait, so the signals need no reset between rounds.
+class RoundProgress {
+ public:
+  // Serial, before the region: the next round, with a signal for each of `threads` threads on `cores`
+  // processors (more threads than cores: a waiter soon yields its core, which the thread it waits for may need).
+  std::uint64_t beginRound(int threads, int cores);
+  // Thread t has written its first `done` items of `round` (release: the items are visible to a waiter).
+  void publish(int t, std::uint64_t round, std::uint32_t done) {
+    m_slots[t].value.store(round << 32 | done, std::memory_order_release);
+  }
+  // Wait until thread s has published at least `done` items of `round` (acquire); returns how many it has.
+  std::uint32_t waitFor(int s, std::uint64_t round, std::uint32_t done) const;
+
+ private:
+  struct alignas(64) Slot {
+    std::atomic<std::uint64_t> value{0};  // round << 32 | items written
+  };
+  static constexpr int kSpins = 1 << 14, kSpinsOversubscribed = 64;  // pauses before each yield
+  std::unique_ptr<Slot[]> m_slots;
+  int m_capacity = 0;
+  int m_spins = kSpins;
+  std::uint64_t m_round = 0;  // < 2^32: past it the signals are cleared and the count starts again
+};
+
 // The runs one thread takes of a loop: for (std::size_t b, e; runs.next(b, e);) { ... items [b, e) ... }. From the
 // ranges when they were set for a team of this size (of 2 or more), else its static share of `count` items,
 // whole. A plain loop, not a callback: the step's loops inside lambdas ran ~10 % slower (docs/performance.md).

@@ -1,5 +1,6 @@
 // The threads' shares and what crosses between them (core/thread_boundary.hpp): every partner a pass reads
-// from another share has a halo slot its owner fills, every seed covers exactly the leading adjacency entries
+// from another share has a halo slot its owner fills, in the order the pairs first read them and before the
+// reader's block waits for it, every seed covers exactly the leading adjacency entries
 // that one other thread computed, and the kick's own entries are all of its own share. The bits of the
 // halo and seed paths are checked against one thread by tests/determinism_test.cpp.
 #include <gtest/gtest.h>
@@ -104,6 +105,24 @@ void checkBoundary(const ContactStore& c, std::size_t n, int nt) {
   }
   for (std::size_t p = c.size(); p < b.haloPairs.size() * ThreadBoundary::kHaloBlock; ++p)
     EXPECT_EQ((b.haloPairs.back() >> (p % ThreadBoundary::kHaloBlock)) & 1u, 0u) << "a bit past the last pair";
+  // the order an owner copies its slots in: that of the pairs that first read them; and what a reader waits
+  // for before a block: every slot that block and the next read, counted from the start of its owner's group
+  ASSERT_EQ(b.haloNeed.size(), b.haloPairs.size());
+  std::vector<std::size_t> firstRead(b.halo.size(), c.size());
+  for (std::size_t p = 0; p < c.size(); ++p) {
+    if (b.partner[p] < static_cast<std::int32_t>(n)) continue;
+    const std::size_t slot = static_cast<std::size_t>(b.partner[p]) - n;
+    firstRead[slot] = std::min(firstRead[slot], p);
+    const std::size_t place = slot - b.haloBegin[owner[b.halo[slot]]];
+    const std::size_t block = p / ThreadBoundary::kHaloBlock;
+    EXPECT_LT(place, b.haloNeed[block]) << "pair " << p << " reads a slot its block does not wait for";
+    if (block > 0) {
+      EXPECT_LT(place, b.haloNeed[block - 1]) << "pair " << p << " is prefetched before its slot is waited for";
+    }
+  }
+  for (int t = 0; t < nt; ++t)
+    for (std::size_t q = b.haloBegin[t]; q + 1 < b.haloBegin[t + 1]; ++q)
+      EXPECT_LT(firstRead[q], firstRead[q + 1]) << "owner " << t << ", slot " << q;
   // with two shares only the first particle of the second share can keep foreign entries unseeded (its
   // own pairs straddle the split): at most its entries
   if (nt == 2) {

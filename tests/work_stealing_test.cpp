@@ -4,6 +4,7 @@
 // on who computed which item is checked by tests/determinism_test.cpp.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <random>
@@ -203,4 +204,51 @@ TEST(WorkStealing, TwoPhaseClaimsOfAStaticShare) {
   EXPECT_FALSE(claims.nextOwn(b, e));
   claims.waitForTakers();
   EXPECT_FALSE(claims.nextTaken(b, e));
+}
+
+// A round's progress (RoundProgress, the contact pass's halo): two owners write their items in batches of random
+// size at random speed and publish each count; a reader that asks for the first k items of an owner finds all
+// k written in this round, and is told at least k. Rounds follow one another as the passes do (the team meets
+// between them). With a no-op wait the reader finds items of the last round. Once with as many threads as
+// cores, once as if on one core (the waits then yield almost at once).
+TEST(WorkStealing, AReaderFindsTheItemsAnOwnerPublishedInThisRound) {
+  constexpr int kThreads = 3;  // thread 0 reads, 1 and 2 own items
+  constexpr std::uint32_t kItems = 300;
+  for (const int cores : {kThreads, 1}) {
+    SCOPED_TRACE(cores);
+    RoundProgress progress;
+    std::vector<std::vector<long>> value(kThreads, std::vector<long>(kItems, 0));
+    std::atomic<long> stale{0}, short_{0}, checked{0};
+    for (int pass = 0; pass < 30; ++pass) {
+      const std::uint64_t round = progress.beginRound(kThreads, cores);
+      std::vector<std::thread> team;
+      for (int t = 0; t < kThreads; ++t)
+        team.emplace_back([&, t] {
+          std::mt19937 rng(static_cast<unsigned>(round * kThreads + static_cast<std::uint64_t>(t)));
+          if (t > 0) {
+            std::uint32_t done = 0;
+            while (done < kItems) {
+              const std::uint32_t end = std::min(kItems, done + 1 + static_cast<std::uint32_t>(rng() % 40));
+              if (rng() % 2) std::this_thread::sleep_for(std::chrono::microseconds(rng() % 30));
+              for (; done < end; ++done) value[t][done] = static_cast<long>(round);
+              progress.publish(t, round, done);
+            }
+            return;
+          }
+          for (std::uint32_t need = 0; need < kItems;) {
+            need = std::min(kItems, need + 1 + static_cast<std::uint32_t>(rng() % 25));
+            for (int s = 1; s < kThreads; ++s) {
+              const std::uint32_t have = progress.waitFor(s, round, need);
+              short_ += have < need;
+              for (std::uint32_t i = 0; i < need; ++i) stale += value[s][i] != static_cast<long>(round);
+              checked += need;
+            }
+          }
+        });
+      for (std::thread& th : team) th.join();
+    }
+    EXPECT_EQ(stale.load(), 0) << "items read before their owner wrote them in this round";
+    EXPECT_EQ(short_.load(), 0);
+    EXPECT_GT(checked.load(), 0);
+  }
 }
