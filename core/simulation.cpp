@@ -416,11 +416,15 @@ void Simulation::kickPass(const DriftPlan* plan) {
   if constexpr (kLocalDamping) m_kickWork.resize(3 * static_cast<std::size_t>(n));
   double* kickWork = m_kickWork.data();
   updateShares();
-  m_ranges.reset(m_boundary.begin, kParticleGrain);
   const ThreadBoundary& tb = m_boundary;
   const KickSeed* seeds = m_seeds.data();
   const bool seedsReady = m_seedsReady;
   m_seedsReady = false;
+  // After a pass with the halo and seeds (a state in cache; the boundary's team) each thread kicks its own share
+  // whole (one run of all of it, so none is left to take): a run another thread took here made it write the
+  // pass lines, and read the result lines, of particles whose pairs the owner computes next, each a round trip
+  // between the cores in the next pass (with the vCPUs far apart the 2-thread step was ~6 % slower for it).
+  m_ranges.reset(m_boundary.begin, kSeeded && seedsReady ? static_cast<std::size_t>(n) : kParticleGrain);
   // kDrift: the next step's drift of each particle right after its kick (run)
   Vec3* x = m_p.pos.data();
   const Vec3* x0 = m_refPos.data();
