@@ -100,7 +100,7 @@ std::uint64_t RoundProgress::beginRound(int threads, int cores) {
     m_capacity = threads;
     m_round = 0;
   }
-  if (++m_round == std::uint64_t{1} << 32) {  // after ~4e9 rounds: start again from round 1
+  if (++m_round >= m_restartAt) {  // after ~4e9 rounds: start again from round 1
     for (int t = 0; t < m_capacity; ++t) m_slots[t].value.store(0, std::memory_order_relaxed);
     m_round = 1;
   }

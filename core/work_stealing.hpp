@@ -75,6 +75,10 @@ class StealingRanges {
 // whole copy. A value of an earlier round never satisfies a wait, so the signals need no reset between rounds.
 class RoundProgress {
  public:
+  // Rounds run 1 .. roundsBeforeRestart - 1 (at most 2^32 - 1, so that a round and a count share one word), then
+  // start again at 1 with the signals cleared (a test sets a small number).
+  explicit RoundProgress(std::uint64_t roundsBeforeRestart = std::uint64_t{1} << 32)
+      : m_restartAt(roundsBeforeRestart) {}
   // Serial, before the region: the next round, with a signal for each of `threads` threads on `cores`
   // processors (more threads than cores: a waiter soon yields its core, which the thread it waits for may need).
   std::uint64_t beginRound(int threads, int cores);
@@ -93,7 +97,8 @@ class RoundProgress {
   std::unique_ptr<Slot[]> m_slots;
   int m_capacity = 0;
   int m_spins = kSpins;
-  std::uint64_t m_round = 0;  // < 2^32: past it the signals are cleared and the count starts again
+  std::uint64_t m_restartAt;
+  std::uint64_t m_round = 0;
 };
 
 // The runs one thread takes of a loop: for (std::size_t b, e; runs.next(b, e);) { ... items [b, e) ... }. From the

@@ -1,6 +1,7 @@
 // The claims of the step's parallel loops (core/work_stealing.hpp): every item is taken exactly once, an owner
 // takes its own share from the front in runs of the grain, a thread whose own share is empty takes the share
-// before its own from the back, and a team of another size gets the static split. That the bits do not depend
+// before its own from the back, and a team of another size gets the static split; a reader of a round's
+// progress (RoundProgress) finds the items it waited for. That the bits do not depend
 // on who computed which item is checked by tests/determinism_test.cpp.
 #include <gtest/gtest.h>
 
@@ -210,27 +211,38 @@ TEST(WorkStealing, TwoPhaseClaimsOfAStaticShare) {
 // size at random speed and publish each count; a reader that asks for the first k items of an owner finds all
 // k written in this round, and is told at least k. Rounds follow one another as the passes do (the team meets
 // between them). With a no-op wait the reader finds items of the last round. Once with as many threads as
-// cores, once as if on one core (the waits then yield almost at once).
+// cores, once as if on one core (the waits then yield almost at once), and once with the rounds restarting
+// every 4 (as after 2^32 passes), where a value is tagged with the pass, not the round.
 TEST(WorkStealing, AReaderFindsTheItemsAnOwnerPublishedInThisRound) {
   constexpr int kThreads = 3;  // thread 0 reads, 1 and 2 own items
   constexpr std::uint32_t kItems = 300;
-  for (const int cores : {kThreads, 1}) {
-    SCOPED_TRACE(cores);
-    RoundProgress progress;
+  struct Case {
+    int cores;
+    std::uint64_t restartAt;
+  };
+  for (const Case c : {Case{kThreads, std::uint64_t{1} << 32}, Case{1, std::uint64_t{1} << 32}, Case{kThreads, 5}}) {
+    SCOPED_TRACE(c.cores);
+    SCOPED_TRACE(c.restartAt);
+    RoundProgress progress(c.restartAt);
     std::vector<std::vector<long>> value(kThreads, std::vector<long>(kItems, 0));
     std::atomic<long> stale{0}, short_{0}, checked{0};
-    for (int pass = 0; pass < 30; ++pass) {
-      const std::uint64_t round = progress.beginRound(kThreads, cores);
+    std::uint64_t restarts = 0, last = 0;
+    for (int pass = 1; pass <= 30; ++pass) {
+      const std::uint64_t round = progress.beginRound(kThreads, c.cores);
+      ASSERT_GE(round, 1u);
+      ASSERT_LT(round, c.restartAt);
+      restarts += round <= last;
+      last = round;
       std::vector<std::thread> team;
       for (int t = 0; t < kThreads; ++t)
         team.emplace_back([&, t] {
-          std::mt19937 rng(static_cast<unsigned>(round * kThreads + static_cast<std::uint64_t>(t)));
+          std::mt19937 rng(static_cast<unsigned>(pass * kThreads + t));
           if (t > 0) {
             std::uint32_t done = 0;
             while (done < kItems) {
               const std::uint32_t end = std::min(kItems, done + 1 + static_cast<std::uint32_t>(rng() % 40));
               if (rng() % 2) std::this_thread::sleep_for(std::chrono::microseconds(rng() % 30));
-              for (; done < end; ++done) value[t][done] = static_cast<long>(round);
+              for (; done < end; ++done) value[t][done] = pass;
               progress.publish(t, round, done);
             }
             return;
@@ -240,7 +252,7 @@ TEST(WorkStealing, AReaderFindsTheItemsAnOwnerPublishedInThisRound) {
             for (int s = 1; s < kThreads; ++s) {
               const std::uint32_t have = progress.waitFor(s, round, need);
               short_ += have < need;
-              for (std::uint32_t i = 0; i < need; ++i) stale += value[s][i] != static_cast<long>(round);
+              for (std::uint32_t i = 0; i < need; ++i) stale += value[s][i] != pass;
               checked += need;
             }
           }
@@ -250,5 +262,6 @@ TEST(WorkStealing, AReaderFindsTheItemsAnOwnerPublishedInThisRound) {
     EXPECT_EQ(stale.load(), 0) << "items read before their owner wrote them in this round";
     EXPECT_EQ(short_.load(), 0);
     EXPECT_GT(checked.load(), 0);
+    EXPECT_EQ(restarts, c.restartAt == 5 ? 7u : 0u);  // rounds 1-4, then again from 1: 30 passes restart 7 times
   }
 }
