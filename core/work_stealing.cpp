@@ -11,6 +11,19 @@ namespace {
 constexpr std::uint64_t pack(std::uint64_t front, std::uint64_t back) { return back << 32 | front; }
 constexpr std::uint64_t frontOf(std::uint64_t w) { return w & 0xffffffffu; }
 constexpr std::uint64_t backOf(std::uint64_t w) { return w >> 32; }
+
+// One turn of a wait for another thread: a pause for the first `spins` turns (the waits last microseconds), then
+// the core given away, which the awaited thread may need when there are more threads than cores.
+void backOff(int turn, int spins) {
+  if (turn < spins) {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+  } else {
+    std::this_thread::yield();
+  }
+}
+constexpr int kSpins = 1 << 14;  // the pauses before yielding, when the team fits on the cores
 }  // namespace
 
 void StealingRanges::reset(const std::vector<std::size_t>& bounds, std::size_t grain) {
@@ -86,14 +99,12 @@ void StealingRanges::waitForTakers(int t) const {
   const std::uint64_t w = s.bounds.load(std::memory_order_relaxed);
   assert(frontOf(w) >= backOf(w));
   const std::uint64_t taken = s.end - backOf(w);
-  while (s.takenDone.load(std::memory_order_acquire) < taken) {
-#if defined(__x86_64__) || defined(__i386__)
-    __builtin_ia32_pause();
-#endif
-  }
+  for (int turn = 0; s.takenDone.load(std::memory_order_acquire) < taken; ++turn) backOff(turn, kSpins);
 }
 
 std::uint64_t RoundProgress::beginRound(int threads, int cores) {
+  // with more threads than cores the owner may be waiting for a waiter's core: yield almost at once, as
+  // libgomp's barriers do
   m_spins = threads > cores ? kSpinsOversubscribed : kSpins;
   if (threads > m_capacity) {
     m_slots = std::make_unique<Slot[]>(static_cast<std::size_t>(threads));  // every signal at round 0
@@ -110,18 +121,9 @@ std::uint64_t RoundProgress::beginRound(int threads, int cores) {
 std::uint32_t RoundProgress::waitFor(int s, std::uint64_t round, std::uint32_t done) const {
   assert(s < m_capacity);
   const std::uint64_t target = round << 32 | done;
-  // spin a while (the copy takes microseconds), then give the core away: with more threads than cores the
-  // owner may be waiting for this one's core (so then almost at once, as libgomp's barriers do)
   std::uint64_t value;
-  for (int spins = 0; (value = m_slots[s].value.load(std::memory_order_acquire)) < target; ++spins) {
-    if (spins < m_spins) {
-#if defined(__x86_64__) || defined(__i386__)
-      __builtin_ia32_pause();
-#endif
-    } else {
-      std::this_thread::yield();
-    }
-  }
+  for (int turn = 0; (value = m_slots[s].value.load(std::memory_order_acquire)) < target; ++turn)
+    backOff(turn, m_spins);
   assert(value >> 32 == round);  // the owner publishes no later round before the region ends
   return static_cast<std::uint32_t>(value);
 }

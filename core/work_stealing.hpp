@@ -93,10 +93,10 @@ class RoundProgress {
   struct alignas(64) Slot {
     std::atomic<std::uint64_t> value{0};  // round << 32 | items written
   };
-  static constexpr int kSpins = 1 << 14, kSpinsOversubscribed = 64;  // pauses before each yield
+  static constexpr int kSpinsOversubscribed = 64;  // pauses before yielding with more threads than cores
   std::unique_ptr<Slot[]> m_slots;
   int m_capacity = 0;
-  int m_spins = kSpins;
+  int m_spins = 0;  // set by beginRound
   std::uint64_t m_restartAt;
   std::uint64_t m_round = 0;
 };
