@@ -341,7 +341,7 @@ int main(int argc, char** argv) {
       rates.push_back(static_cast<double>(n) * static_cast<double>(o.steps) / s);
       profiles.push_back(sim.profile());
       if (r == 0) {
-        res.finalPos = sim.particles().pos;
+        res.finalPos.assign(sim.particles().pos.begin(), sim.particles().pos.end());
         res.fingerprint = stateFingerprint(sim);
         res.pEnd = sim.contactStress().trace() / 3.0;
         res.zEnd = contactCounts(sim).coordination;

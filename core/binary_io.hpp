@@ -21,8 +21,8 @@ class BinaryWriter {
     const auto* b = reinterpret_cast<const char*>(&v);
     m_buf.append(b, sizeof(T));
   }
-  template <class T>
-  void putVector(const std::vector<T>& v) {
+  template <class T, class A>
+  void putVector(const std::vector<T, A>& v) {
     static_assert(std::is_trivially_destructible_v<T> && std::is_standard_layout_v<T>);  // POD-like (Eigen fixed-size included)
     put<std::uint64_t>(v.size());
     m_buf.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
@@ -62,12 +62,12 @@ class BinaryReader {
     m_pos += sizeof(T);
     return v;
   }
-  template <class T>
-  std::vector<T> getVector(const char* field, std::uint64_t maxCount = 1ull << 31) {
+  template <class T, class A = std::allocator<T>>
+  std::vector<T, A> getVector(const char* field, std::uint64_t maxCount = 1ull << 31) {
     const auto n = get<std::uint64_t>(field);
     if (n > maxCount || n * sizeof(T) > m_buf.size() - m_pos)
       fail(std::string("implausible length ") + std::to_string(n) + " for " + field);
-    std::vector<T> v(n);
+    std::vector<T, A> v(n);
     if (n) std::memcpy(static_cast<void*>(v.data()), m_buf.data() + m_pos, n * sizeof(T));
     m_pos += n * sizeof(T);
     return v;

@@ -37,7 +37,7 @@ struct PassArrays {
   const Mat3& L;  // velocity gradient
   double dt;      // [s]
   std::size_t np;  // listed pairs
-  PassArrays(const std::vector<PassParticle>& pass, const ParticleStore& p, ContactStore& c,
+  PassArrays(const HugeVector<PassParticle>& pass, const ParticleStore& p, ContactStore& c,
              const PeriodicCell& periodicCell, double timeStep)
       : pp(pass.data()), w(p.angVel.data()), mat(p.material.data()), first(c.first.data()),
         second(c.second.data()), image(c.image.data()), hist(c.history.data()), result(c.result.data()),

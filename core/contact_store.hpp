@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "huge_pages.hpp"
 #include "particle_store.hpp"
 #include "periodic_cell.hpp"
 #include "types.hpp"
@@ -64,27 +65,27 @@ static_assert(sizeof(PairResult) == 64 && alignof(PairResult) == 64, "one aligne
 
 struct ContactStore {
   // pair definition (rebuilt with the neighbour list)
-  std::vector<std::int32_t> first, second;  // particle indices i < j
-  std::vector<Image> image;                  // shift applied to j
+  HugeVector<std::int32_t> first, second;  // particle indices i < j
+  HugeVector<Image> image;                  // shift applied to j
   // history (carried over across rebuilds by key)
-  std::vector<ContactHistory> history;
-  std::vector<MdHistory> mdHistory;  // same length as history with the Mindlin–Deresiewicz law, else empty
+  HugeVector<ContactHistory> history;
+  HugeVector<MdHistory> mdHistory;  // same length as history with the Mindlin–Deresiewicz law, else empty
   // results of the last force pass, one line per pair
-  std::vector<PairResult> result;
+  HugeVector<PairResult> result;
   // bit p % 64 of word p / 64 is set when pair p holds a contact, i.e. its history has a > 0: the default law's
   // pass finds the contacts that opened from these words instead of reading every listed pair's history.
   // Mirrors the history while touchedValid (markTouched sets both; the other law's pass clears the flag; a new
   // or restored store starts without).
-  std::vector<std::uint64_t> touched;
+  HugeVector<std::uint64_t> touched;
   bool touchedValid = false;
   // adjacency: pairs of particle k are adjEntry[adjStart[k] .. adjStart[k+1]) as (pair << 1 | side),
   // side 0 when k is the pair's first particle, 1 when second.
-  std::vector<std::int32_t> adjStart, adjEntry;
+  HugeVector<std::int32_t> adjStart, adjEntry;
 
   std::size_t size() const { return first.size(); }
   bool active(std::size_t p) const { return result[p].overlap > 0.0; }
   // |l| = r_i + r_j - delta, for a touching pair
-  double distance(std::size_t p, const std::vector<double>& radius) const {
+  double distance(std::size_t p, const HugeVector<double>& radius) const {
     return radius[first[p]] + radius[second[p]] - result[p].overlap;
   }
   // the branch vector l = x_j + H image - x_i from i to j's image, and the contact normal n = l / |l|, from the

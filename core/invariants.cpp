@@ -23,7 +23,7 @@ void checkInvariants(const Simulation& sim) {
   if (!(sim.cell().volume() > 0.0)) violated("cell volume <= 0");
   // the contact pass reads its own copy of the particles: it must hold the store's bits (but for the
   // velocity, which the kick has moved on by half a step since the pass read it)
-  const std::vector<PassParticle>& pass = sim.passParticles();
+  const HugeVector<PassParticle>& pass = sim.passParticles();
   if (pass.size() != n) violated("the contact pass's particle copy has the wrong length");
   for (std::size_t i = 0; i < n; ++i) {
     const PassParticle& q = pass[i];

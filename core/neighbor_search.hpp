@@ -14,9 +14,9 @@
 
 namespace fl {
 
-struct PairList {
-  std::vector<std::int32_t> first, second;
-  std::vector<Image> image;
+struct PairList {  // in the contact store's arrays (huge_pages.hpp), moved there whole
+  HugeVector<std::int32_t> first, second;
+  HugeVector<Image> image;
 };
 
 // Positions must be wrapped into the cell. Output pairs are sorted by (i, j).

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "huge_pages.hpp"
 #include "types.hpp"
 
 namespace fl {
@@ -26,14 +27,14 @@ static_assert(sizeof(PassParticle) == 64, "one cache line per particle");
 
 struct ParticleStore {
   // hot
-  std::vector<Vec3> pos;      // x [m]
-  std::vector<Vec3> vel;      // v', fluctuating velocity [m/s]
-  std::vector<Vec3> angVel;   // omega [rad/s]
-  std::vector<Vec3> force;    // total force of the last force pass [N]
-  std::vector<Vec3> torque;   // total torque [N m]
-  std::vector<double> radius;      // r [m]
-  std::vector<double> invMass;     // 1/m [1/kg] (density scaling applied)
-  std::vector<double> invInertia;  // 1/I, I = (2/5) m r^2 [1/(kg m^2)]
+  HugeVector<Vec3> pos;      // x [m]
+  HugeVector<Vec3> vel;      // v', fluctuating velocity [m/s]
+  HugeVector<Vec3> angVel;   // omega [rad/s]
+  HugeVector<Vec3> force;    // total force of the last force pass [N]
+  HugeVector<Vec3> torque;   // total torque [N m]
+  HugeVector<double> radius;      // r [m]
+  HugeVector<double> invMass;     // 1/m [1/kg] (density scaling applied)
+  HugeVector<double> invInertia;  // 1/I, I = (2/5) m r^2 [1/(kg m^2)]
   // cold
   std::vector<std::int32_t> id;         // stable identity, survives re-ordering
   std::vector<std::uint16_t> material;  // index into the material list

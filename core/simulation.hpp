@@ -98,7 +98,7 @@ class Simulation {
   const ContactStore& contacts() const { return m_c; }
   // The contact pass's copy of x, r, v, 1/m, one line per particle. Between steps x, r and 1/m equal the
   // store's (checkInvariants checks it); v is the mid-step velocity the last pass used.
-  const std::vector<PassParticle>& passParticles() const { return m_pass; }
+  const HugeVector<PassParticle>& passParticles() const { return m_pass; }
   const std::vector<Material>& materials() const { return m_materials; }
   const NumericsSettings& numerics() const { return m_num; }
   double time() const { return m_time; }     // [s]
@@ -218,7 +218,7 @@ class Simulation {
   void updateShares();
 
   ParticleStore m_p;
-  std::vector<PassParticle> m_pass;  // the contact pass's copy of x, r, v, 1/m (particle_store.hpp)
+  HugeVector<PassParticle> m_pass;  // the contact pass's copy of x, r, v, 1/m (particle_store.hpp)
   PeriodicCell m_cell;
   std::vector<Material> m_materials;
   PairTable m_pairs;
@@ -232,7 +232,7 @@ class Simulation {
   double m_meanDiameter = 0.0;  // [m], the automatic skin's unit (verlet_skin.hpp)
   long m_listSteps = 0;         // steps since the last rebuild
   // rebuild bookkeeping
-  std::vector<Vec3> m_refPos;  // positions at the last rebuild
+  HugeVector<Vec3> m_refPos;  // positions at the last rebuild
   Mat3 m_refHinv;              // H^-1 at the last rebuild
   double m_maxDisp2 = 0.0;     // max |x - F x_ref|^2 after the last drift
 

@@ -25,9 +25,9 @@ std::uint32_t quantise(double s) {
   return static_cast<std::uint32_t>(std::clamp(q, 0.0, 1023.0));  // callers pass finite s only
 }
 
-template <class T>
-void permute(std::vector<T>& a, const std::vector<std::size_t>& order) {
-  std::vector<T> out;
+template <class T, class A>
+void permute(std::vector<T, A>& a, const std::vector<std::size_t>& order) {
+  std::vector<T, A> out;
   out.reserve(a.size());
   for (std::size_t k : order) out.push_back(a[k]);
   a.swap(out);

@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <span>
 
 #include "atomic_file.hpp"
 #include "errors.hpp"
@@ -56,7 +57,7 @@ void beginPiece(std::string& s, std::size_t points, std::size_t cells) {
        "\">\n";
 }
 
-void writePoints(std::string& s, const std::vector<Vec3>& pts) {
+void writePoints(std::string& s, std::span<const Vec3> pts) {
   s += "      <Points>\n";
   beginArray(s, "Float64", nullptr, 3);
   for (const Vec3& x : pts) put(s, x);

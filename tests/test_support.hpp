@@ -48,8 +48,8 @@ inline Vec3 momentum(const ParticleStore& p) {
 }
 
 // True when both arrays hold the same bits (determinism and restart tests compare states bit for bit).
-template <class T>
-bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {
+template <class T, class A>
+bool sameBits(const std::vector<T, A>& a, const std::vector<T, A>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
 }
 

@@ -48,7 +48,7 @@ void fillParticles(const Simulation& sim, Snapshot& out) {
   const std::size_t n = p.size();
   out.cell = cell.matrix();
   out.positions.resize(n);
-  out.radii = p.radius;
+  out.radii.assign(p.radius.begin(), p.radius.end());
   out.speeds.resize(n);
   out.contactCounts.assign(n, 0);
   out.meanStress.assign(n, 0.0);
