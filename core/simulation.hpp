@@ -270,7 +270,7 @@ class Simulation {
   std::vector<Chunk> m_chunks;
   // the kick's local-damping work terms of each particle (3 per particle, in the order the serial sum adds
   // them), summed per fixed chunk of particles after the kick: the threads' shares need not fall on chunks
-  std::vector<double> m_kickWork;
+  HugeVector<double> m_kickWork;
   // Runs of particles a thread claims at a time in the drift and the kick: ~0.9 µs of drift and ~2.6 µs of kick
   // work at ~14 and ~41 ns a particle (4000 spheres, one thread), against a claim's ~10 ns (an atomic on a line
   // its own thread holds); 32 and 128 were no better (docs/performance.md, twelfth session).
