@@ -8,8 +8,11 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <type_traits>
 
+#include "core/contact_store.hpp"
 #include "core/huge_pages.hpp"
+#include "core/particle_store.hpp"
 
 using namespace fl;
 
@@ -44,6 +47,17 @@ bool kernelHasTransparentHugePages() {
 #endif
 
 }  // namespace
+
+// The arrays the step sweeps at large N come from the allocator (docs/performance.md, twenty-fourth session).
+template <class V>
+constexpr bool kHuge = std::is_same_v<typename V::allocator_type, HugePageAllocator<typename V::value_type>>;
+static_assert(kHuge<decltype(ParticleStore::pos)> && kHuge<decltype(ParticleStore::vel)> &&
+              kHuge<decltype(ParticleStore::angVel)> && kHuge<decltype(ParticleStore::radius)> &&
+              kHuge<decltype(ParticleStore::invMass)> && kHuge<decltype(ParticleStore::invInertia)>);
+static_assert(kHuge<decltype(ContactStore::first)> && kHuge<decltype(ContactStore::second)> &&
+              kHuge<decltype(ContactStore::image)> && kHuge<decltype(ContactStore::history)> &&
+              kHuge<decltype(ContactStore::result)> && kHuge<decltype(ContactStore::adjEntry)> &&
+              kHuge<decltype(ContactStore::touched)>);
 
 TEST(HugePages, SmallArraysStayInTheHeapAndLargeOnesAreAlignedToAHugePage) {
   HugeVector<double> small(1000, 1.0);
