@@ -4,7 +4,7 @@
 // here grants transparent huge pages only to ranges that ask for them (madvise), so the hot arrays of the
 // particle and contact stores are allocated through HugePageAllocator: an allocation of at least
 // kHugePageThreshold bytes is mapped on its own, aligned to 2 MiB and advised MADV_HUGEPAGE before its first
-// touch; smaller ones (every array of a 4000-sphere scene but the pair lines) come from std::allocator as
+// touch; smaller ones (every array of a 4000-sphere scene: its pair lines take 0.8 MB) come from std::allocator as
 // before. Only where the memory sits changes, never a value: the bits are those of std::vector. On the Zen 4 host
 // the 1-thread step ran 10 % faster at 256 000 spheres and 4.5 % at 1M (docs/performance.md, twenty-fourth
 // session); 2 MiB pages for the small arrays too were level at 4000 spheres.
