@@ -72,6 +72,11 @@ class BinaryReader {
     m_pos += n * sizeof(T);
     return v;
   }
+  // getVector into `into`, whatever its allocator (the engine's hot arrays are HugeVectors, huge_pages.hpp)
+  template <class T, class A>
+  void getVectorInto(std::vector<T, A>& into, const char* field, std::uint64_t maxCount = 1ull << 31) {
+    into = getVector<T, A>(field, maxCount);
+  }
   std::string getString(const char* field) {
     auto v = getVector<char>(field, 1ull << 30);
     return std::string(v.begin(), v.end());

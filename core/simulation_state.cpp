@@ -160,14 +160,14 @@ Simulation Simulation::restoreState(BinaryReader& r) {
     r.fail(std::string("invalid numerics: ") + e.what());
   }
   ParticleStore& p = s.m_p;
-  p.pos = r.getVector<Vec3, HugePageAllocator<Vec3>>("positions");
-  p.vel = r.getVector<Vec3, HugePageAllocator<Vec3>>("velocities");
-  p.angVel = r.getVector<Vec3, HugePageAllocator<Vec3>>("angular velocities");
-  p.force = r.getVector<Vec3, HugePageAllocator<Vec3>>("forces");
-  p.torque = r.getVector<Vec3, HugePageAllocator<Vec3>>("torques");
-  p.radius = r.getVector<double, HugePageAllocator<double>>("radii");
-  p.invMass = r.getVector<double, HugePageAllocator<double>>("inverse masses");
-  p.invInertia = r.getVector<double, HugePageAllocator<double>>("inverse inertias");
+  r.getVectorInto(p.pos, "positions");
+  r.getVectorInto(p.vel, "velocities");
+  r.getVectorInto(p.angVel, "angular velocities");
+  r.getVectorInto(p.force, "forces");
+  r.getVectorInto(p.torque, "torques");
+  r.getVectorInto(p.radius, "radii");
+  r.getVectorInto(p.invMass, "inverse masses");
+  r.getVectorInto(p.invInertia, "inverse inertias");
   p.id = r.getVector<std::int32_t>("ids");
   p.material = r.getVector<std::uint16_t>("material indices");
   p.image = r.getVector<Vec3i>("images");
@@ -184,11 +184,11 @@ Simulation Simulation::restoreState(BinaryReader& r) {
   if (!(H.determinant() > 0.0) || !(Href.determinant() > 0.0)) r.fail("cell matrix is not invertible");
   s.m_cell.restore(H, L, Href, logStrain, logComp);
   ContactStore& c = s.m_c;
-  c.first = r.getVector<std::int32_t, HugePageAllocator<std::int32_t>>("pair first");
-  c.second = r.getVector<std::int32_t, HugePageAllocator<std::int32_t>>("pair second");
-  c.image = r.getVector<Image, HugePageAllocator<Image>>("pair image");
-  c.history = r.getVector<ContactHistory, HugePageAllocator<ContactHistory>>("contact history");
-  if (version >= 3) c.mdHistory = r.getVector<MdHistory, HugePageAllocator<MdHistory>>("Mindlin-Deresiewicz history");
+  r.getVectorInto(c.first, "pair first");
+  r.getVectorInto(c.second, "pair second");
+  r.getVectorInto(c.image, "pair image");
+  r.getVectorInto(c.history, "contact history");
+  if (version >= 3) r.getVectorInto(c.mdHistory, "Mindlin-Deresiewicz history");
   // version 4: the moments n x f; before: the normals
   const auto normalOrMoment = r.getVector<Vec3>(version >= 4 ? "contact moments" : "contact normals");
   const auto overlap = r.getVector<double>("contact overlaps");
@@ -227,7 +227,7 @@ Simulation Simulation::restoreState(BinaryReader& r) {
   s.m_skin = r.get<double>("skin");
   s.m_cutoff = r.get<double>("cutoff");
   s.m_meanDiameter = meanDiameter(s.m_p);
-  s.m_refPos = r.getVector<Vec3, HugePageAllocator<Vec3>>("reference positions");
+  r.getVectorInto(s.m_refPos, "reference positions");
   if (s.m_refPos.size() != n) r.fail("reference positions have the wrong length");
   s.m_refHinv = getMat(r, "reference inverse cell");
   s.m_maxDisp2 = r.get<double>("max displacement");
