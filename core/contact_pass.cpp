@@ -196,11 +196,11 @@ void Simulation::contactPassBlocked() {
     // outside this thread's own particles (another core drifted them; none with one thread)
     const bool all = arr.n >= kLargeStateFrom;
     const bool stream = all;  // result lines by streaming stores (kLargeStateFrom)
-    const bool remote = all || nt > 1;
+    const bool remote = !all && nt > 1;
     const bool own = nt == m_boundary.threads;
     const auto ownFrom = static_cast<std::uint32_t>(own ? m_boundary.begin[t] : staticBegin(t, nt, arr.n));
     const auto ownTo = static_cast<std::uint32_t>(own ? m_boundary.begin[t + 1] : staticBegin(t + 1, nt, arr.n));
-    const std::uint32_t ownSpan = all ? 0 : ownTo - ownFrom;  // every partner lies outside an empty span
+    const std::uint32_t ownSpan = ownTo - ownFrom;
     const std::uint64_t* haloPairs = tb.haloPairs.data();  // exchange: the pairs that read a halo slot
     const std::uint32_t* haloNeed = tb.haloNeed.data();
     ThreadRuns runs(m_ranges, t, nt, nchunks);  // the chunks this thread computes, run by run
@@ -247,9 +247,10 @@ void Simulation::contactPassBlocked() {
       for (std::size_t p0 = k * kChunk; p0 < chunkEnd; p0 += kernels::kBlockPairs) {
         const std::size_t p1 = std::min(chunkEnd, p0 + kernels::kBlockPairs);
         // the next block's partners that are not in cache: the lines a later thread drifts (on this kind of VM
-        // a line last written by the other core arrives 50-200 ns late, docs/performance.md), or all when the
-        // state outgrows the caches (a whole sweep lies between a line's drift and its pass). At 4000 spheres
-        // (3 MB) prefetching every partner cost ~15 % of a 1-thread step.
+        // a line last written by the other core arrives 50-200 ns late, docs/performance.md). At 4000 spheres
+        // (3 MB) prefetching every partner cost ~15 % of a 1-thread step. When the state outgrows the caches
+        // (a whole sweep lies between a line's drift and its pass) every partner is prefetched in loop 1a
+        // instead, kPartnerAhead pairs ahead.
         if (haloOnly) {
           awaitHalo(haloNeed[p0 / kernels::kBlockPairs]);  // this block's slots and the next one's
           if (p1 < np)
@@ -272,6 +273,11 @@ void Simulation::contactPassBlocked() {
         int m = 0;
         std::uint64_t touchingNow = 0;
         for (std::size_t p = p0; p < p1; ++p) {
+          if (all && p + kPartnerAhead < np) {  // one pair's partner per pair, not a burst per block
+            const std::int32_t ahead = partner[p + kPartnerAhead];
+            __builtin_prefetch(&passOf(ahead));
+            __builtin_prefetch(&omegaOf(ahead));
+          }
           const int i = arr.first[p];
           const PassParticle& pj = passOf(partner[p]);
           Vec3 d = pj.x - pass[i].x;  // l = x_j + H image - x_i

@@ -258,6 +258,11 @@ class Simulation {
   // pairs outside the thread's own share of the pass (another core most likely wrote them), or all from
   // kLargeStateFrom particles: with one thread at 4000 spheres, prefetching every entry cost 2-7 % of a step.
   static constexpr int kPrefetchEntries = 140;
+  // How far ahead (listed pairs, ~40 particles) the contact pass prefetches each partner's pass line and omega
+  // when the state outgrows the caches: one pair's prefetch per pair computed, spread through the block's
+  // geometry loop. The same prefetches issued as a burst of 128 per block of 64 pairs left the pass 7 % slower
+  // at 1M spheres (docs/performance.md, twenty-fifth session); 96 to 256 pairs ahead measured alike.
+  static constexpr std::size_t kPartnerAhead = 128;
   // Partial sums of one fixed block of pairs (or particles), reduced in block order.
   struct Chunk {
     Mat3 stress = Mat3::Zero();  // sum f (x) l [N m]
