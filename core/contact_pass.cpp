@@ -112,6 +112,7 @@ void Simulation::contactPassBlocked() {
   static_assert(kChunk % kernels::kBlockPairs == 0, "reduction chunks hold whole blocks");
   static_assert(kernels::kBlockPairs == 64, "a block's touching pairs are one word of ContactStore::touched");
   static_assert(ThreadBoundary::kHaloBlock == kernels::kBlockPairs, "a block's halo pairs are one word");
+  static_assert(sizeof(ContactHistory) == 32, "two pairs' history per line (kHistoryAhead's prefetch)");
   if (!m_c.touchedValid) m_c.markTouched();  // after a rebuild, a restore or the other law's pass
   std::uint64_t* touched = m_c.touched.data();
   const PassArrays arr(m_pass, m_p, m_c, m_cell, m_dt);
@@ -250,7 +251,7 @@ void Simulation::contactPassBlocked() {
         // a line last written by the other core arrives 50-200 ns late, docs/performance.md). At 4000 spheres
         // (3 MB) prefetching every partner cost ~15 % of a 1-thread step. When the state outgrows the caches
         // (a whole sweep lies between a line's drift and its pass) every partner is prefetched in loop 1a
-        // instead, kPartnerAhead pairs ahead.
+        // instead, kPartnerAhead pairs ahead, and the history lines kHistoryAhead pairs ahead, for writing.
         if (haloOnly) {
           awaitHalo(haloNeed[p0 / kernels::kBlockPairs]);  // this block's slots and the next one's
           if (p1 < np)
@@ -273,6 +274,8 @@ void Simulation::contactPassBlocked() {
         int m = 0;
         std::uint64_t touchingNow = 0;
         for (std::size_t p = p0; p < p1; ++p) {
+          if (all && (p & 1) == 0 && p + kHistoryAhead < np)  // a line holds two pairs' history
+            __builtin_prefetch(&arr.hist[p + kHistoryAhead], 1);
           if (all && p + kPartnerAhead < np) {  // one pair's partner per pair, not a burst per block
             const std::int32_t ahead = partner[p + kPartnerAhead];
             __builtin_prefetch(&passOf(ahead));
