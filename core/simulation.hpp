@@ -260,11 +260,11 @@ class Simulation {
   static constexpr int kPrefetchEntries = 140;
   // How far ahead (listed pairs, ~40 particles) the contact pass prefetches each partner's pass line and omega
   // when the state outgrows the caches: one pair's prefetch per pair computed, spread through the block's
-  // geometry loop. The same prefetches issued as a burst of 128 per block of 64 pairs left the pass 7 % slower
+  // geometry loop. The same prefetches issued as a burst of 128 per block of 64 pairs left the step 6 % slower
   // at 1M spheres (docs/performance.md, twenty-fifth session); 96 to 256 pairs ahead measured alike.
   static constexpr std::size_t kPartnerAhead = 128;
   // How far ahead (listed pairs, 8 KiB) the same loop prefetches the history lines it reads and writes back, one
-  // line per two pairs: 256 000 and 1M spheres ~4 % faster on 1 thread, ~5 % on 2 (twenty-fifth session; a burst
+  // line per two pairs: 256 000 and 1M spheres 4-6 % faster on 1 thread, ~5 % on 2 (twenty-fifth session; a burst
   // of the 32 lines of a later block was 3-10 % slower in the nineteenth and twenty-fourth).
   static constexpr std::size_t kHistoryAhead = 256;
   // Partial sums of one fixed block of pairs (or particles), reduced in block order.
