@@ -14,6 +14,8 @@
 //
 //   bench_dense [--threads 1,2] [--steps 20000] [--repeats 5] [--cache FILE] [--export-lammps FILE]
 //               [--no-energy] [--skin METRES|settled] [--order file|morton|shuffled] [--tile NX,NY,NZ]
+//               [--shares measured|even]
+// --shares even keeps the threads' shares equal instead of following their measured speeds (share_balance.hpp).
 // --skin settled fixes the skin at the one the automatic skin settles to on the untiled packing (settledSkin):
 // every size of bench/scaling.sh then runs on the same list, whatever its number of steps.
 // --tile replicates the periodic packing NX x NY x NZ times (same density, stress and contacts per particle:
@@ -62,6 +64,7 @@ struct Options {
   double skin = 0.0;  // 0: the engine's automatic skin (core/verlet_skin.hpp)
   bool settledSkin = false;  // --skin settled: fixed at the automatic skin's settled value (settledSkin below)
   std::array<int, 3> tile{1, 1, 1};  // periodic replicas of the packing per axis
+  bool evenShares = false;  // --shares even: equal shares, not measured ones (core/share_balance.hpp)
   // particle order: Z-order (core/spatial_order.hpp), the cached packing's, or a seeded random permutation
   // (what a packing imported in arbitrary order would run at, were it not sorted)
   enum class Order { Morton, File, Shuffled } order = Order::Morton;
@@ -71,7 +74,7 @@ struct Options {
   std::fprintf(stderr,
                "bench_dense: %s\nusage: bench_dense [--threads 1,2] [--steps N] [--repeats N] [--cache FILE]\n"
                "                   [--export-lammps FILE] [--no-energy] [--skin METRES|settled] [--order file|morton|shuffled]\n"
-               "                   [--tile NX,NY,NZ]\n",
+               "                   [--tile NX,NY,NZ] [--shares measured|even]\n",
                msg);
   std::exit(2);
 }
@@ -115,6 +118,10 @@ Options parse(int argc, char** argv) {
       const std::string v = value();
       if (v != "file" && v != "morton" && v != "shuffled") usage("--order takes file, morton or shuffled");
       o.order = v == "morton" ? Options::Order::Morton : v == "file" ? Options::Order::File : Options::Order::Shuffled;
+    } else if (a == "--shares") {
+      const std::string v = value();
+      if (v != "measured" && v != "even") usage("--shares takes measured or even");
+      o.evenShares = v == "even";
     } else if (a == "-h" || a == "--help") {
       usage("help");
     } else {
@@ -236,7 +243,9 @@ Simulation measuredScene(const Simulation& prepared, int threads, const Options&
   num.skin = o.skin;
   num.trackEnergy = o.trackEnergy;
   num.threads = threads;
-  return Simulation(std::move(p), cell, prepared.materials(), num);
+  Simulation sim(std::move(p), cell, prepared.materials(), num);
+  if (o.evenShares) sim.setFixedShares({});
+  return sim;
 }
 
 // Resident set size of this process [bytes] (Linux /proc/self/statm; 0 elsewhere).
@@ -322,12 +331,13 @@ int main(int argc, char** argv) {
     std::uint64_t fingerprint = 0;  // of the final state, to compare builds (bench/ab.sh)
     std::size_t pairsEnd = 0;
     double pEnd = 0, zEnd = 0, skinEnd = 0;  // skinEnd: the list's skin at the end (automatic: core/verlet_skin.hpp)
+    std::vector<std::size_t> edges;  // where the threads' chunks began at the end (core/share_balance.hpp)
   };
   std::vector<Result> results;
   double memoryPerParticle = 0.0, peakResident = 0.0;
   for (int t : o.threads) {
     std::vector<double> rates;
-    Result res{t, 0, 0, 0, {}, {}, 0, 0, 0};
+    Result res{t, 0, 0, 0, {}, {}, 0, 0, 0, 0, 0, {}};
     std::vector<StageProfile> profiles;
     for (int r = 0; r < o.repeats; ++r) {
       Simulation sim = measuredScene(prepared, t, o);
@@ -347,6 +357,7 @@ int main(int argc, char** argv) {
         res.zEnd = contactCounts(sim).coordination;
         res.skinEnd = sim.skin();
         res.pairsEnd = sim.contacts().size();
+        res.edges = sim.threadBoundary().chunkBegin;
       }
     }
     res.median = median(rates);
@@ -376,6 +387,12 @@ int main(int argc, char** argv) {
                   100.0 * r.profile.seconds[s] / tot);
     std::printf("  (the kick holds the next drift in %ld of %ld steps: Simulation::run)\n", r.profile.fusedKicks,
                 r.profile.steps);
+    if (r.threads > 1) {
+      std::printf("shares, %d threads: %s, made again %ld times; last edges (pair chunks):", r.threads,
+                  o.evenShares ? "equal (--shares even)" : "measured", r.profile.shareChanges);
+      for (std::size_t e : r.edges) std::printf(" %zu", e);
+      std::printf(" (first repeat)\n");
+    }
   }
   for (const Result& r : results)
     std::printf("after %ld steps, %d thread(s): p = %.6g Pa, Z = %.6f, skin = %.6g m, pairs in list %zu\n", o.steps,

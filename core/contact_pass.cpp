@@ -5,6 +5,7 @@
 // force and the elastic energies to measureContacts, which reads them off the stored contacts when asked for;
 // the Mindlin–Deresiewicz law runs one pair at a time (mindlin_deresiewicz.hpp) and sums them all itself.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -129,11 +130,16 @@ void Simulation::contactPassBlocked() {
   const auto n = static_cast<std::int32_t>(arr.n);
   int team = 0;
   RoundProgress& haloProgress = m_haloProgress;
+  ShareBalance& balance = m_balance;
   const std::uint64_t round = haloProgress.beginRound(m_num.threads, omp_get_num_procs());
 #pragma omp parallel num_threads(m_num.threads)
   {
     const int t = omp_get_thread_num(), nt = omp_get_num_threads();
     if (t == 0) team = nt;
+    // this thread's time and chunks, for the shares of the next boundaries (share_balance.hpp)
+    const bool timed = nt > 1 && nt == tb.threads && balance.measuring();
+    const auto start = timed ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
+    std::size_t chunksDone = 0;
     // with the boundary of this team: each owner first copies the partners other threads read into the halo
     // (thread_boundary.hpp), and the pass reads them there, whichever thread computes the pair. No barrier: the
     // owner publishes its progress every kHaloBatch slots, and a reader waits before a block of its share for
@@ -216,7 +222,10 @@ void Simulation::contactPassBlocked() {
       if (takenItems != 0) runs.doneTaken(takenItems);
       takenItems = 0;
       if (!taking) {
-        if (runs.nextOwn(runBegin, runEnd)) return true;
+        if (runs.nextOwn(runBegin, runEnd)) {
+          chunksDone += runEnd - runBegin;
+          return true;
+        }
         taking = true;
         if (exchange) {
           runs.waitForTakers();
@@ -234,6 +243,7 @@ void Simulation::contactPassBlocked() {
       }
       if (!runs.nextTaken(runBegin, runEnd)) return false;
       takenItems = runEnd - runBegin;
+      chunksDone += takenItems;
       return true;
     };
     for (std::size_t runBegin, runEnd; nextRun(runBegin, runEnd);)
@@ -360,6 +370,8 @@ void Simulation::contactPassBlocked() {
       chunks[k] = acc;
     }
     if (stream) streamFence();  // the kick's threads read these lines after the region's barrier
+    if (timed)
+      balance.addPass(t, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), chunksDone);
   }
   m_seedsReady = kHalo && team == tb.threads && tb.exchange;
   m_profile.stolenRuns += static_cast<long>(m_ranges.stolen());

@@ -351,13 +351,24 @@ void Simulation::resizeChunks() {
   m_seedsReady = false;
 }
 
+std::vector<std::size_t> Simulation::chunkFirstParticles() const {
+  const std::size_t chunks = (m_c.size() + kChunk - 1) / kChunk;
+  std::vector<std::size_t> first(chunks + 1, m_p.size());
+  for (std::size_t k = 0; k < chunks; ++k) first[k] = static_cast<std::size_t>(m_c.first[k * kChunk]);
+  return first;
+}
+
 void Simulation::updateShares() {
   const int nt = std::max(1, m_num.threads);
   if (m_boundary.threads == nt) return;
   // each thread's particles start at the first particle of its first chunk's pairs (pairs are sorted by their
   // first particle); without a chunk each, the particles are split statically and nothing is exchanged; the
   // halo and seeds only while the state stays in cache (kLargeStateFrom)
-  m_boundary = buildThreadBoundary(m_c, m_p.size(), nt, kChunk, m_p.size() < kLargeStateFrom);
+  // the shares' edges: equal, fixed or from the threads' measured costs (share_balance.hpp)
+  m_balance.prepare(nt);
+  std::vector<std::size_t> edges;
+  if (nt > 1) edges = m_balance.edges(nt, chunkFirstParticles());
+  m_boundary = buildThreadBoundary(m_c, m_p.size(), nt, kChunk, m_p.size() < kLargeStateFrom, edges);
   m_haloPass.resize(m_boundary.halo.size());
   m_haloW.resize(m_boundary.halo.size());
   m_seeds.assign(m_boundary.seedParticle.size(), KickSeed{});
@@ -430,6 +441,7 @@ void Simulation::kickPass(const DriftPlan* plan) {
   const Vec3* x0 = m_refPos.data();
   PassParticle* pass = m_pass.data();
   double maxd2 = 0.0;
+  ShareBalance& balance = m_balance;
 #pragma omp parallel num_threads(m_num.threads) reduction(max : maxd2)
   {
   const int thread = omp_get_thread_num(), threads = omp_get_num_threads();
@@ -452,8 +464,13 @@ void Simulation::kickPass(const DriftPlan* plan) {
   const bool large = static_cast<std::size_t>(n) >= kLargeStateFrom;
   const bool fetch = large || (threads > 1 && !seeded);
   const std::uint32_t ownSpan = large ? 0 : ownTo - ownFrom;  // every entry lies outside an empty span
+  // this thread's time and particles, for the shares of the next boundaries (share_balance.hpp)
+  const bool timed = threads > 1 && own && balance.measuring();
+  const auto start = timed ? Clock::now() : Clock::time_point{};
+  std::size_t particlesDone = 0;
   ThreadRuns runs(m_ranges, thread, threads, static_cast<std::size_t>(n));  // the particles this thread kicks, run by run
   for (std::size_t begin, end; runs.next(begin, end);) {
+  particlesDone += end - begin;
   // the next seeded particle from this run's first on (the list ends with an index past every particle)
   std::size_t nextSeed = 0;
   if (kSeeded && seeded)
@@ -511,6 +528,7 @@ void Simulation::kickPass(const DriftPlan* plan) {
     w[i] = wi;
   }
   }
+  if (timed) balance.addKick(thread, since(start), particlesDone);
   if constexpr (kLocalDamping) {
     // the work of each fixed chunk of particles, summed in particle order: the same bits for any split
 #pragma omp barrier
@@ -524,6 +542,12 @@ void Simulation::kickPass(const DriftPlan* plan) {
   }
   }
   m_profile.stolenRuns += static_cast<long>(m_ranges.stolen());
+  // every kWindowSteps steps: shares that follow the threads' speeds, made at the next pass if they moved
+  if (m_boundary.threads > 1 && m_balance.endStep() &&
+      m_balance.reconsider(m_boundary.chunkBegin, chunkFirstParticles())) {
+    m_boundary.threads = 0;
+    ++m_profile.shareChanges;
+  }
   if constexpr (kDrift) m_maxDisp2 = maxd2;
   if constexpr (kLocalDamping) {
     if (m_num.trackEnergy)

@@ -33,6 +33,7 @@
 #include "numerics.hpp"
 #include "particle_store.hpp"
 #include "periodic_cell.hpp"
+#include "share_balance.hpp"
 #include "thread_boundary.hpp"
 #include "verlet_skin.hpp"
 #include "work_stealing.hpp"
@@ -52,6 +53,7 @@ struct StageProfile {
   long rebuilds = 0;
   long stolenRuns = 0;  // runs of a parallel loop one thread took from another's share (work_stealing.hpp)
   long fusedKicks = 0;  // steps whose kick ran with the next step's drift (Simulation::run)
+  long shareChanges = 0;  // times the threads' shares were made again from their measured speeds (share_balance.hpp)
   double total() const;
 };
 
@@ -128,6 +130,17 @@ class Simulation {
   const StageProfile& profile() const { return m_profile; }
   // The threads' shares and what crosses between them, as the last parallel step made them (thread_boundary.hpp)
   const ThreadBoundary& threadBoundary() const { return m_boundary; }
+  // The threads' shares of the step: measured from their speed (the default, share_balance.hpp) or fixed (one
+  // weight per thread; empty: equal). Neither changes the results, only the time.
+  void setFixedShares(std::vector<double> shares) {
+    m_balance.fix(std::move(shares));
+    m_boundary.threads = 0;  // made again at the next use
+  }
+  void setMeasuredShares() {
+    m_balance.measure();
+    m_boundary.threads = 0;
+  }
+  const ShareBalance& shareBalance() const { return m_balance; }
   // Heap bytes held by the state (particle and pair arrays by capacity, history, adjacency, reduction
   // chunks); the neighbour grid is a temporary of each rebuild and not counted.
   std::size_t memoryBytes() const;
@@ -216,6 +229,7 @@ class Simulation {
   // again after each rebuild or restore and when the thread count changes. The parallel loops start from them
   // and balance from there (work_stealing.hpp).
   void updateShares();
+  std::vector<std::size_t> chunkFirstParticles() const;  // the first particle of each pair chunk, then the count
 
   ParticleStore m_p;
   HugeVector<PassParticle> m_pass;  // the contact pass's copy of x, r, v, 1/m (particle_store.hpp)
@@ -288,6 +302,7 @@ class Simulation {
   // the threads' shares of the pair chunks and particles (chunkBegin, begin) with the halo and seeds, for a team
   // of m_boundary.threads (updateShares; 0: to be made)
   ThreadBoundary m_boundary;
+  ShareBalance m_balance;  // where the threads' shares of the boundary begin
   std::vector<PassParticle> m_haloPass;  // halo slots: the pass copy and omega of other threads' partners
   std::vector<Vec3> m_haloW;
   std::vector<KickSeed> m_seeds;  // slot 0 stays zero

@@ -7,7 +7,7 @@
 namespace fl {
 
 ThreadBoundary buildThreadBoundary(const ContactStore& c, std::size_t particleCount, int threads,
-                                   std::size_t chunk, bool halo) {
+                                   std::size_t chunk, bool halo, const std::vector<std::size_t>& edges) {
   ThreadBoundary b;
   const int nt = std::max(1, threads);
   const std::size_t n = particleCount, np = c.size();
@@ -15,7 +15,11 @@ ThreadBoundary buildThreadBoundary(const ContactStore& c, std::size_t particleCo
   b.threads = nt;
   b.begin.resize(nt + 1);
   b.chunkBegin.resize(nt + 1);
-  for (int t = 0; t <= nt; ++t) b.chunkBegin[t] = staticBegin(t, nt, chunks);
+  // given edges of this list (a chunk each, ascending), else the static split
+  bool given = edges.size() == static_cast<std::size_t>(nt) + 1 && edges.front() == 0 && edges.back() == chunks;
+  for (int t = 0; given && t < nt; ++t) given = edges[t] < edges[t + 1];
+  if (given) b.chunkBegin = edges;
+  else for (int t = 0; t <= nt; ++t) b.chunkBegin[t] = staticBegin(t, nt, chunks);
   const bool aligned = nt > 1 && chunks >= static_cast<std::size_t>(nt);
   const bool exchange = aligned && halo;
   for (int t = 0; t <= nt; ++t)

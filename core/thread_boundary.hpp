@@ -1,7 +1,8 @@
 // What crosses between the threads' shares of one step (issue 6: the 2-thread speed-up; docs/performance.md,
-// ninth and nineteenth sessions). The particles are split where the contact pass's static split of the pair
-// chunks puts each thread's first pair, so a thread drifts and kicks the particles whose pairs it computes as
-// first particle. These are the shares each thread starts from; the loops then balance as they go
+// ninth and nineteenth sessions). The particles are split where the contact pass's split of the pair chunks
+// (equal, or at edges from the threads' measured costs: share_balance.hpp) puts each thread's first pair, so a
+// thread drifts and kicks the particles whose pairs it computes as first particle. These are the shares each
+// thread starts from; the loops then balance as they go
 // (work_stealing.hpp), and a run taken from another share reads its lines in place.
 // What still crosses goes through two compact arrays instead of the owners' own lines:
 //  - halo: the partners another thread's pass reads (x, r, v, 1/m and omega after the drift), copied by their
@@ -88,13 +89,14 @@ inline void kickEntry(const PairResult& c, std::int32_t entry, double ri, double
 }
 
 // The boundary of `threads` shares for the store's pairs (sorted by first particle, adjacency built) over
-// `particleCount` particles, with the pass splitting ceil(pairs / chunk) chunks statically. With one thread,
+// `particleCount` particles, with the pass splitting ceil(pairs / chunk) chunks statically, or at `edges` when
+// given (threads + 1 ascending chunk indices, the last the chunk count: share_balance.hpp). With one thread,
 // or fewer chunks than threads, the shares are the static split of the particles and nothing is exchanged
 // (exchange false: the per-pair and per-particle arrays are left empty).
 // halo: false gives the shares alone (exchange false), for states that outgrow the caches, where the lines
 // crossing the shares' seam are a small part of what every step streams from memory (at 256 000 spheres the
 // halo and seeds made 2 threads 1-6 % slower: docs/performance.md, nineteenth session).
 ThreadBoundary buildThreadBoundary(const ContactStore& c, std::size_t particleCount, int threads,
-                                   std::size_t chunk, bool halo = true);
+                                   std::size_t chunk, bool halo = true, const std::vector<std::size_t>& edges = {});
 
 }  // namespace fl

@@ -68,3 +68,31 @@ TEST(Determinism, RunsTakenFromAnotherThreadGiveTheSameBits) {
   EXPECT_GT(b.threadBoundary().seedParticle.size(), 1u);
   expectSameBits(a, b);
 }
+
+// The threads' shares follow their measured costs (core/share_balance.hpp) and so differ from run to run; any
+// edges give the bits of one thread. Skewed fixed shares, changed in the middle of a run (the boundary is made
+// again at the next pass, its halo and seeds with it), against one thread; then the measured shares, made again
+// at least once here because their first window of steps is taken on a boundary with equal shares.
+TEST(Determinism, SkewedAndMeasuredSharesGiveTheSameBits) {
+  Simulation a = compressingGas(1, 0.0, 1.0, false);
+  a.run(4000);
+  ASSERT_GT(a.contacts().activeCount(), 1000u) << "the test must exercise many contacts";
+  Simulation b = compressingGas(2, 0.0, 1.0, false);
+  b.setFixedShares({1.0, 4.0});
+  b.run(3200);
+  const std::size_t firstEdge = b.threadBoundary().chunkBegin.at(1);
+  b.setFixedShares({4.0, 1.0});
+  b.run(800);
+  const std::size_t secondEdge = b.threadBoundary().chunkBegin.at(1);
+  const std::size_t chunks = b.threadBoundary().chunkBegin.back();
+  EXPECT_LT(firstEdge, chunks / 3) << "the first thread's share is a fifth";
+  EXPECT_GT(secondEdge, 2 * chunks / 3) << "then four fifths";
+  EXPECT_TRUE(b.threadBoundary().exchange);
+  expectSameBits(a, b);
+
+  Simulation c = compressingGas(3, 0.0, 1.0, false);  // measured (the default)
+  c.run(4000);
+  EXPECT_TRUE(c.shareBalance().measuring());
+  EXPECT_EQ(c.shareBalance().costs().size(), 3u) << "the windows measured every thread";
+  expectSameBits(a, c);
+}

@@ -30,9 +30,9 @@ Simulation gas() {
   return Simulation(std::move(pk.particles), pk.cell, {Material::paperGlass()}, num);
 }
 
-void checkBoundary(const ContactStore& c, std::size_t n, int nt) {
+void checkBoundary(const ContactStore& c, std::size_t n, int nt, const std::vector<std::size_t>& edges = {}) {
   SCOPED_TRACE(nt);
-  const ThreadBoundary b = buildThreadBoundary(c, n, nt, kChunk);
+  const ThreadBoundary b = buildThreadBoundary(c, n, nt, kChunk, true, edges);
   ASSERT_EQ(b.threads, nt);
   ASSERT_TRUE(b.exchange);
   ASSERT_EQ(b.begin.front(), 0u);
@@ -147,6 +147,28 @@ TEST(ThreadBoundary, HaloAndSeedsCoverWhatCrossesForTwoToFourThreads) {
   const ContactStore& c = denseContacts(sim);
   ASSERT_GT(c.size(), 4 * kChunk) << "the test must give every thread pair chunks";
   for (int nt : {2, 3, 4}) checkBoundary(c, sim.particles().size(), nt);
+}
+
+// The shares' edges measured from the threads' costs (core/share_balance.hpp): the chunks split where given, the
+// particles at the first particle of each share's first chunk, and the halo and seeds whole for any edges.
+TEST(ThreadBoundary, GivenEdgesSplitTheChunksThere) {
+  Simulation sim = gas();
+  const ContactStore& c = denseContacts(sim);
+  const std::size_t n = sim.particles().size(), chunks = (c.size() + kChunk - 1) / kChunk;
+  ASSERT_GT(chunks, 6u);
+  for (const std::vector<std::size_t>& edges : {std::vector<std::size_t>{0, 1, chunks},
+                                                 std::vector<std::size_t>{0, chunks - 2, chunks},
+                                                 std::vector<std::size_t>{0, 1, 2, chunks}}) {
+    const int nt = static_cast<int>(edges.size()) - 1;
+    SCOPED_TRACE(edges[1]);
+    const ThreadBoundary b = buildThreadBoundary(c, n, nt, kChunk, true, edges);
+    EXPECT_EQ(b.chunkBegin, edges);
+    for (int t = 1; t < nt; ++t) EXPECT_EQ(b.begin[t], static_cast<std::size_t>(c.first[kChunk * edges[t]]));
+    checkBoundary(c, n, nt, edges);
+  }
+  // edges of another list (another chunk count) are not used: the static split
+  const ThreadBoundary stale = buildThreadBoundary(c, n, 2, kChunk, true, {0, 1, chunks + 1});
+  EXPECT_EQ(stale.chunkBegin, (std::vector<std::size_t>{0, staticBegin(1, 2, chunks), chunks}));
 }
 
 TEST(ThreadBoundary, FewerChunksThanThreadsSplitsStatically) {
