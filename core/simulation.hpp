@@ -130,15 +130,11 @@ class Simulation {
   const StageProfile& profile() const { return m_profile; }
   // The threads' shares and what crosses between them, as the last parallel step made them (thread_boundary.hpp)
   const ThreadBoundary& threadBoundary() const { return m_boundary; }
-  // The threads' shares of the step: measured from their speed (the default, share_balance.hpp) or fixed (one
-  // weight per thread; empty: equal). Neither changes the results, only the time.
+  // The threads' shares of the step are measured from their speed (the default, share_balance.hpp); fixed here
+  // instead (one weight per thread; empty: equal). Neither changes the results, only the time.
   void setFixedShares(std::vector<double> shares) {
     m_balance.fix(std::move(shares));
     m_boundary.threads = 0;  // made again at the next use
-  }
-  void setMeasuredShares() {
-    m_balance.measure();
-    m_boundary.threads = 0;
   }
   const ShareBalance& shareBalance() const { return m_balance; }
   // Heap bytes held by the state (particle and pair arrays by capacity, history, adjacency, reduction
