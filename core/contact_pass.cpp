@@ -115,27 +115,26 @@ void Simulation::contactPassBlocked() {
   static_assert(ThreadBoundary::kHaloBlock == kernels::kBlockPairs, "a block's halo pairs are one word");
   static_assert(sizeof(ContactHistory) == 32, "two pairs' history per line (kHistoryAhead's prefetch)");
   if (!m_c.touchedValid) m_c.markTouched();  // after a rebuild, a restore or the other law's pass
-  std::uint64_t* touched = m_c.touched.data();
-  const PassArrays arr(m_pass, m_p, m_c, m_cell, m_dt);
-  const std::size_t np = arr.np, nchunks = arr.chunks(kChunk);
-  const PassParticle* pass = arr.pp;
-  const PairTable& table = m_pairs;
-  Chunk* chunks = m_chunks.data();
-  const Vec3* omega = arr.w;
   m_ranges.reset(m_boundary.chunkBegin, 1);  // contactPass made the shares (updateShares)
-  const ThreadBoundary& tb = m_boundary;
-  PassParticle* haloPass = m_haloPass.data();
-  Vec3* haloW = m_haloW.data();
-  KickSeed* seeds = m_seeds.data();
-  const auto n = static_cast<std::int32_t>(arr.n);
   int team = 0;
-  RoundProgress& haloProgress = m_haloProgress;
-  ShareBalance& balance = m_balance;
-  const std::uint64_t round = haloProgress.beginRound(m_num.threads, omp_get_num_procs());
-#pragma omp parallel num_threads(m_num.threads)
-  {
-    const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+  const std::uint64_t round = m_haloProgress.beginRound(m_num.threads, omp_get_num_procs());
+  const auto loop = [this, &team, round](const int t, const int nt) {
     if (t == 0) team = nt;
+    // locals of each thread, which no store of the pass can alias (kickPass)
+    std::uint64_t* touched = m_c.touched.data();
+    const PassArrays arr(m_pass, m_p, m_c, m_cell, m_dt);
+    const std::size_t np = arr.np, nchunks = arr.chunks(kChunk);
+    const PassParticle* pass = arr.pp;
+    const PairTable& table = m_pairs;
+    Chunk* chunks = m_chunks.data();
+    const Vec3* omega = arr.w;
+    const ThreadBoundary& tb = m_boundary;
+    PassParticle* haloPass = m_haloPass.data();
+    Vec3* haloW = m_haloW.data();
+    KickSeed* seeds = m_seeds.data();
+    const auto n = static_cast<std::int32_t>(arr.n);
+    RoundProgress& haloProgress = m_haloProgress;
+    ShareBalance& balance = m_balance;
     // this thread's time and chunks, for the shares of the next boundaries (share_balance.hpp)
     const bool timed = nt > 1 && nt == tb.threads && balance.measuring();
     const auto start = timed ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
@@ -372,17 +371,22 @@ void Simulation::contactPassBlocked() {
     if (stream) streamFence();  // the kick's threads read these lines after the region's barrier
     if (timed)
       balance.addPass(t, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), chunksDone);
-  }
-  m_seedsReady = kHalo && team == tb.threads && tb.exchange;
+  };
+  m_team.each(m_num.threads, loop);
+  m_seedsReady = kHalo && team == m_boundary.threads && m_boundary.exchange;
   m_profile.stolenRuns += static_cast<long>(m_ranges.stolen());
   // the diagnostics' extremes and means and the elastic energies are read off the stored contacts on demand
-  reduceContactChunks<kEnergy, false>(nchunks);
+  reduceContactChunks<kEnergy, false>((m_c.size() + kChunk - 1) / kChunk);
 }
 
 template <bool kEnergy, bool kDamping, bool kAffine>
 void Simulation::contactPassMindlinDeresiewicz() {
   m_c.touchedValid = false;  // this pass changes the history without ContactStore::touched
   m_seedsReady = false;      // nor does it sum the seeds: the kick reads every entry
+  updateShares();
+  m_ranges.reset(m_boundary.chunkBegin, 1);
+  const auto loop = [this](const int t, const int nt) {
+  // locals of each thread, which no store of the pass can alias (kickPass)
   const PassArrays arr(m_pass, m_p, m_c, m_cell, m_dt);
   const std::size_t np = arr.np, nchunks = arr.chunks(kChunk);
   const PassParticle* pass = arr.pp;
@@ -391,11 +395,7 @@ void Simulation::contactPassMindlinDeresiewicz() {
   MdHistory* mdHist = m_c.mdHistory.data();
   const PairTable& table = m_pairs;
   Chunk* chunks = m_chunks.data();
-  updateShares();
-  m_ranges.reset(m_boundary.chunkBegin, 1);
-#pragma omp parallel num_threads(m_num.threads)
-  {
-  ThreadRuns runs(m_ranges, omp_get_thread_num(), omp_get_num_threads(), nchunks);
+  ThreadRuns runs(m_ranges, t, nt, nchunks);
   for (std::size_t runBegin, runEnd; runs.next(runBegin, runEnd);)
   for (std::size_t k = runBegin; k < runEnd; ++k) {
     Chunk acc;
@@ -480,9 +480,10 @@ void Simulation::contactPassMindlinDeresiewicz() {
     }
     chunks[k] = acc;
   }
-  }
+  };
+  m_team.each(m_num.threads, loop);
   m_profile.stolenRuns += static_cast<long>(m_ranges.stolen());
-  reduceContactChunks<kEnergy, true>(nchunks);
+  reduceContactChunks<kEnergy, true>((m_c.size() + kChunk - 1) / kChunk);
 }
 
 template <bool kEnergy, bool kMeasured>

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "errors.hpp"
+#include "thread_team.hpp"
 
 namespace fl {
 
@@ -66,7 +67,8 @@ PairList findPairsBruteForce(const ParticleStore& p, const PeriodicCell& cell, d
   return L;
 }
 
-PairList findPairsGrid(const ParticleStore& p, const PeriodicCell& cell, double skin, int threads) {
+PairList findPairsGrid(const ParticleStore& p, const PeriodicCell& cell, double skin, int threads,
+                       ThreadTeam* team) {
   const double cutoff = 2.0 * p.maxRadius() + skin;
   checkCellSize(cell, cutoff);
   const Vec3 w = cell.perpendicularWidths();
@@ -93,7 +95,8 @@ PairList findPairsGrid(const ParticleStore& p, const PeriodicCell& cell, double 
   }
   // per-particle candidate lists, built in parallel, concatenated in particle order (deterministic)
   std::vector<std::vector<std::pair<std::int32_t, Image>>> found(n);
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 64)
+  const auto search = [&](int, int) {
+#pragma omp for schedule(dynamic, 64)
   for (int i = 0; i < n; ++i) {
     const int bi = binOf[i];
     const int bx = bi % nb.x(), by = (bi / nb.x()) % nb.y(), bz = bi / (nb.x() * nb.y());
@@ -119,6 +122,9 @@ PairList findPairsGrid(const ParticleStore& p, const PeriodicCell& cell, double 
         }
     std::sort(out.begin(), out.end(), [](auto& a, auto& b) { return a.first < b.first; });
   }
+  };
+  ThreadTeam forked;  // not held: each() forks
+  (team != nullptr ? *team : forked).each(threads, search);
   PairList L;
   std::size_t total = 0;
   for (auto& f : found) total += f.size();
@@ -134,10 +140,10 @@ PairList findPairsGrid(const ParticleStore& p, const PeriodicCell& cell, double 
   return L;
 }
 
-PairList findPairs(const ParticleStore& p, const PeriodicCell& cell, double skin, int threads) {
+PairList findPairs(const ParticleStore& p, const PeriodicCell& cell, double skin, int threads, ThreadTeam* team) {
   const double cutoff = 2.0 * p.maxRadius() + skin;
   const Vec3 w = cell.perpendicularWidths();
-  if ((w / cutoff).minCoeff() >= 3.0) return findPairsGrid(p, cell, skin, threads);
+  if ((w / cutoff).minCoeff() >= 3.0) return findPairsGrid(p, cell, skin, threads, team);
   PairList L = findPairsBruteForce(p, cell, skin);
   sortPairs(L);
   return L;

@@ -14,16 +14,21 @@
 
 namespace fl {
 
+class ThreadTeam;
+
 struct PairList {  // in the contact store's arrays (huge_pages.hpp), moved there whole
   HugeVector<std::int32_t> first, second;
   HugeVector<Image> image;
 };
 
-// Positions must be wrapped into the cell. Output pairs are sorted by (i, j).
-PairList findPairsGrid(const ParticleStore& p, const PeriodicCell& cell, double skin, int threads);
+// Positions must be wrapped into the cell. Output pairs are sorted by (i, j). `team`: the held team of a run
+// (thread_team.hpp), else `threads` threads are forked.
+PairList findPairsGrid(const ParticleStore& p, const PeriodicCell& cell, double skin, int threads,
+                       ThreadTeam* team = nullptr);
 PairList findPairsBruteForce(const ParticleStore& p, const PeriodicCell& cell, double skin);
 // Chooses the grid when the cell holds at least 3 bins per direction, else brute force.
-PairList findPairs(const ParticleStore& p, const PeriodicCell& cell, double skin, int threads);
+PairList findPairs(const ParticleStore& p, const PeriodicCell& cell, double skin, int threads,
+                   ThreadTeam* team = nullptr);
 // Throws CellTooSmallError when the cell cannot hold the interaction range unambiguously.
 void checkCellSize(const PeriodicCell& cell, double cutoff);
 

@@ -6,7 +6,6 @@
 #include <limits>
 #include <type_traits>
 
-#include <omp.h>
 
 #include "errors.hpp"
 #include "neighbor_search.hpp"
@@ -114,22 +113,25 @@ void Simulation::run(long steps) {
   // does not store them, and leaves x and v in the pass copy alone (m_storeBehind); the last step's kick
   // stands alone and writes them all back, so the run ends on a whole step. 4000 spheres ~4.5 % faster on 1
   // thread and ~4 % on 2, 256 000 spheres 4-8 % (bench/ab.sh; docs/performance.md, twentieth session).
-  auto& sec = m_profile.seconds;
-  auto t0 = Clock::now();
-  drift();
-  sec[int(Stage::Drift)] += since(t0);
-  for (long k = 0; k < steps; ++k) {
-    forcesAndControl();
-    auto t1 = Clock::now();
-    if (k + 1 < steps) {
-      kick(KickMode::ThenDrift);  // this step's closing kick and the next step's drift
-      ++m_profile.fusedKicks;
-    } else {
-      kick(KickMode::Closing);  // and x and v back into the store
+  // The team is held for all the steps: each loop is handed to the waiting threads, not forked (thread_team.hpp).
+  m_team.hold(m_num.threads, [this, steps] {
+    auto& sec = m_profile.seconds;
+    auto t0 = Clock::now();
+    drift();
+    sec[int(Stage::Drift)] += since(t0);
+    for (long k = 0; k < steps; ++k) {
+      forcesAndControl();
+      auto t1 = Clock::now();
+      if (k + 1 < steps) {
+        kick(KickMode::ThenDrift);  // this step's closing kick and the next step's drift
+        ++m_profile.fusedKicks;
+      } else {
+        kick(KickMode::Closing);  // and x and v back into the store
+      }
+      sec[int(Stage::Kick)] += since(t1);  // with the next step's drift when fused
+      ++m_profile.steps;
     }
-    sec[int(Stage::Kick)] += since(t1);  // with the next step's drift when fused
-    ++m_profile.steps;
-  }
+  });
 }
 
 // 2.-4.: neighbours, contacts, the clock and the controller. The controller reads only what the
@@ -225,7 +227,13 @@ template <class Plan>
 }  // namespace
 
 void Simulation::drift() {
-  const DriftPlan d = beginDrift();
+  const DriftPlan plan = beginDrift();
+  updateShares();
+  m_ranges.reset(m_boundary.begin, kParticleGrain);
+  m_threadMax.reset(m_num.threads);
+  const auto loop = [this, &plan](const int thread, const int threads) {
+  // locals of each thread, which no store of the loop can alias (kickPass)
+  const DriftPlan d = plan;
   Vec3* x = m_p.pos.data();
   Vec3* v = m_p.vel.data();
   Vec3* w = m_p.angVel.data();
@@ -236,14 +244,9 @@ void Simulation::drift() {
   const Vec3* x0 = m_refPos.data();
   PassParticle* pass = m_pass.data();
   const std::size_t n = m_p.size();
-  double maxd2 = 0.0;
-  updateShares();
-  m_ranges.reset(m_boundary.begin, kParticleGrain);
-#pragma omp parallel num_threads(m_num.threads) reduction(max : maxd2)
-  {
-  const int thread = omp_get_thread_num();
   const bool prefetch = thread > 0;  // see kPrefetchAhead
-  ThreadRuns runs(m_ranges, thread, omp_get_num_threads(), n);  // the particles this thread moves, run by run
+  double maxd2 = 0.0;
+  ThreadRuns runs(m_ranges, thread, threads, n);  // the particles this thread moves, run by run
   for (std::size_t begin, end; runs.next(begin, end);)
   for (std::size_t i = begin; i < end; ++i) {
     if (prefetch && i + kPrefetchAhead < n) {
@@ -254,8 +257,10 @@ void Simulation::drift() {
     }
     maxd2 = std::max(maxd2, driftParticle(d, F[i], T[i], v[i], w[i], im[i], ii[i], x[i], x0[i], pass[i]));
   }
-  }
-  m_maxDisp2 = maxd2;
+  m_threadMax.put(thread, maxd2);
+  };
+  m_team.each(m_num.threads, loop);
+  m_maxDisp2 = m_threadMax.max();
   m_profile.stolenRuns += static_cast<long>(m_ranges.stolen());
 }
 
@@ -306,7 +311,7 @@ void Simulation::rebuildNeighbours() {
   }
   // wrap into the cell
   for (std::size_t i = 0; i < n; ++i) m_p.image[i] += m_cell.wrap(m_p.pos[i]);
-  PairList L = findPairs(m_p, m_cell, m_skin, m_num.threads);
+  PairList L = findPairs(m_p, m_cell, m_skin, m_num.threads, &m_team);
   ContactStore next;
   next.first = std::move(L.first);
   next.second = std::move(L.second);
@@ -409,8 +414,22 @@ void Simulation::kickPass(const DriftPlan* plan) {
   constexpr bool kDrift = kMode == KickMode::ThenDrift;
   // after a drift of run(), the pass copy holds x and the mid-step v (the store's may be behind: m_storeBehind)
   constexpr bool kFromPass = kMode != KickMode::Alone;
+  const std::size_t count = m_p.size();
+  const std::size_t nchunks = (count + kChunk - 1) / kChunk;
+  if constexpr (kLocalDamping) m_kickWork.resize(3 * count);
+  updateShares();
+  const bool seedsReady = m_seedsReady;
+  m_seedsReady = false;
+  // After a pass with the halo and seeds (a state in cache; the boundary's team) each thread kicks its own share
+  // whole (one run of all of it, so none is left to take): a run another thread took here made it write the
+  // pass lines, and read the result lines, of particles whose pairs the owner computes next, each a round trip
+  // between the cores in the next pass (with the vCPUs far apart the 2-thread step was ~6 % slower for it).
+  m_ranges.reset(m_boundary.begin, kSeeded && seedsReady ? count : kParticleGrain);
+  m_threadMax.reset(m_num.threads);
+  const auto loop = [this, plan, seedsReady, nchunks](const int thread, const int threads) {
+  // the loop's inputs, locals of each thread: no store of the loop can alias them (read through the closure,
+  // the step size and the arrays' addresses were loaded again after stores: the 2-thread kick ~12 % slower)
   const int n = static_cast<int>(m_p.size());
-  const std::size_t nchunks = (static_cast<std::size_t>(n) + kChunk - 1) / kChunk;
   const double h = 0.5 * m_dt;
   const double alpha = m_num.localDamping;
   const std::int32_t* adjStart = m_c.adjStart.data();
@@ -424,27 +443,15 @@ void Simulation::kickPass(const DriftPlan* plan) {
   Vec3* w = m_p.angVel.data();
   const double* im = m_p.invMass.data();
   const double* ii = m_p.invInertia.data();
-  if constexpr (kLocalDamping) m_kickWork.resize(3 * static_cast<std::size_t>(n));
   double* kickWork = m_kickWork.data();
-  updateShares();
   const ThreadBoundary& tb = m_boundary;
   const KickSeed* seeds = m_seeds.data();
-  const bool seedsReady = m_seedsReady;
-  m_seedsReady = false;
-  // After a pass with the halo and seeds (a state in cache; the boundary's team) each thread kicks its own share
-  // whole (one run of all of it, so none is left to take): a run another thread took here made it write the
-  // pass lines, and read the result lines, of particles whose pairs the owner computes next, each a round trip
-  // between the cores in the next pass (with the vCPUs far apart the 2-thread step was ~6 % slower for it).
-  m_ranges.reset(m_boundary.begin, kSeeded && seedsReady ? static_cast<std::size_t>(n) : kParticleGrain);
   // kDrift: the next step's drift of each particle right after its kick (run)
   Vec3* x = m_p.pos.data();
   const Vec3* x0 = m_refPos.data();
   PassParticle* pass = m_pass.data();
-  double maxd2 = 0.0;
   ShareBalance& balance = m_balance;
-#pragma omp parallel num_threads(m_num.threads) reduction(max : maxd2)
-  {
-  const int thread = omp_get_thread_num(), threads = omp_get_num_threads();
+  double maxd2 = 0.0;
   const DriftPlan d = kDrift ? *plan : DriftPlan{};  // a local copy: the stores below cannot alias it
   // the seeds of the last pass hold the leading entries another thread computed, whichever thread kicks the
   // particle; without them (another team size, the Mindlin–Deresiewicz pass) every entry is read in place
@@ -540,7 +547,9 @@ void Simulation::kickPass(const DriftPlan* plan) {
       m_chunks[k].localDamping = work;
     }
   }
-  }
+  m_threadMax.put(thread, maxd2);
+  };
+  m_team.each(m_num.threads, loop);
   m_profile.stolenRuns += static_cast<long>(m_ranges.stolen());
   // every kWindowSteps steps: shares that follow the threads' speeds, made at the next pass if they moved
   if (m_boundary.threads > 1 && m_balance.endStep() &&
@@ -548,7 +557,7 @@ void Simulation::kickPass(const DriftPlan* plan) {
     m_boundary.threads = 0;
     ++m_profile.shareChanges;
   }
-  if constexpr (kDrift) m_maxDisp2 = maxd2;
+  if constexpr (kDrift) m_maxDisp2 = m_threadMax.max();
   if constexpr (kLocalDamping) {
     if (m_num.trackEnergy)
       for (std::size_t k = 0; k < nchunks; ++k) m_energy.localDampingWork += m_chunks[k].localDamping;

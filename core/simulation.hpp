@@ -35,6 +35,7 @@
 #include "periodic_cell.hpp"
 #include "share_balance.hpp"
 #include "thread_boundary.hpp"
+#include "thread_team.hpp"
 #include "verlet_skin.hpp"
 #include "work_stealing.hpp"
 
@@ -294,6 +295,8 @@ class Simulation {
   // work at ~14 and ~41 ns a particle (4000 spheres, one thread), against a claim's ~10 ns (an atomic on a line
   // its own thread holds); 32 and 128 were no better (docs/performance.md, twelfth session).
   static constexpr std::size_t kParticleGrain = 64;
+  ThreadTeam m_team;        // the threads of the step's loops, held through run() (thread_team.hpp)
+  ThreadMax m_threadMax;    // the largest drift of each thread in the last drift
   StealingRanges m_ranges;  // the claims of the current parallel loop
   // the threads' shares of the pair chunks and particles (chunkBegin, begin) with the halo and seeds, for a team
   // of m_boundary.threads (updateShares; 0: to be made)

@@ -1,9 +1,10 @@
 // Runs of a loop's items claimed by their owner and stolen by its neighbour (work_stealing.hpp).
 #include "work_stealing.hpp"
 
+#include "spin_wait.hpp"
+
 #include <algorithm>
 #include <cassert>
-#include <thread>
 
 namespace fl {
 
@@ -11,19 +12,6 @@ namespace {
 constexpr std::uint64_t pack(std::uint64_t front, std::uint64_t back) { return back << 32 | front; }
 constexpr std::uint64_t frontOf(std::uint64_t w) { return w & 0xffffffffu; }
 constexpr std::uint64_t backOf(std::uint64_t w) { return w >> 32; }
-
-// One turn of a wait for another thread: a pause for the first `spins` turns (the waits last microseconds), then
-// the core given away, which the awaited thread may need when there are more threads than cores.
-void backOff(int turn, int spins) {
-  if (turn < spins) {
-#if defined(__x86_64__) || defined(__i386__)
-    __builtin_ia32_pause();
-#endif
-  } else {
-    std::this_thread::yield();
-  }
-}
-constexpr int kSpins = 1 << 14;  // the pauses before yielding, when the team fits on the cores
 }  // namespace
 
 void StealingRanges::reset(const std::vector<std::size_t>& bounds, std::size_t grain) {
@@ -105,7 +93,7 @@ void StealingRanges::waitForTakers(int t) const {
 std::uint64_t RoundProgress::beginRound(int threads, int cores) {
   // with more threads than cores the owner may be waiting for a waiter's core: yield almost at once, as
   // libgomp's barriers do
-  m_spins = threads > cores ? kSpinsOversubscribed : kSpins;
+  m_spins = spinsFor(threads, cores);
   if (threads > m_capacity) {
     m_slots = std::make_unique<Slot[]>(static_cast<std::size_t>(threads));  // every signal at round 0
     m_capacity = threads;

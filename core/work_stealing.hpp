@@ -93,7 +93,6 @@ class RoundProgress {
   struct alignas(64) Slot {
     std::atomic<std::uint64_t> value{0};  // round << 32 | items written
   };
-  static constexpr int kSpinsOversubscribed = 64;  // pauses before yielding with more threads than cores
   std::unique_ptr<Slot[]> m_slots;
   int m_capacity = 0;
   int m_spins = 0;  // set by beginRound
