@@ -5,7 +5,7 @@
 // cost ~3 µs (libgomp: the master waits at a dock for the woken thread, the join is a team barrier), twice a step:
 // ~6 of the ~146 µs of a 2-thread 4000-sphere step, against ~0.6 µs a loop handed over through one cache line
 // (docs/performance.md, twenty-seventh session). So Simulation::run holds its team in one OpenMP region for all
-// its steps: thread 0 runs the steps, the other threads wait for each loop (a spin on one line, then yielding)
+// its steps: thread 0 runs the steps, the other threads wait for each loop (a spin on one line, then asleep)
 // and run it beside thread 0, whose wait for their ends is a count on another line. Outside a hold, each loop
 // forks a region as before; with one thread it is a plain call.
 //
