@@ -117,7 +117,7 @@ void Simulation::contactPassBlocked() {
   if (!m_c.touchedValid) m_c.markTouched();  // after a rebuild, a restore or the other law's pass
   m_ranges.reset(m_boundary.chunkBegin, 1);  // contactPass made the shares (updateShares)
   int team = 0;
-  const std::uint64_t round = m_haloProgress.beginRound(m_num.threads, omp_get_num_procs());
+  const std::uint64_t round = m_haloProgress.beginRound(m_num.threads, m_team.cores());
   const auto loop = [this, &team, round](const int t, const int nt) {
     if (t == 0) team = nt;
     // locals of each thread, which no store of the pass can alias (kickPass)

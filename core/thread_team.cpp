@@ -21,6 +21,7 @@ struct ThreadTeam::State {
   Posted posted;
   Ended ended;
   int held = 0;              // thread 0's: the held team's size
+  int cores = 0;             // thread 0's: omp_get_num_procs() when the hold began
   std::uint64_t endsSeen = 0;  // thread 0's: ended.count when the last job had ended
   int spins = kSpins;
 };
@@ -37,13 +38,15 @@ void ThreadTeam::post(State& s) {
 }
 
 int ThreadTeam::held() const { return m_s->held; }
+int ThreadTeam::cores() const { return m_s->held != 0 ? m_s->cores : omp_get_num_procs(); }
 
 std::uint64_t ThreadTeam::begin() const { return m_s->posted.count.load(std::memory_order_relaxed); }
 
 void ThreadTeam::enter(int threads) {
   m_s->held = threads;
   m_s->endsSeen = m_s->ended.count.load(std::memory_order_relaxed);
-  m_s->spins = spinsFor(threads, omp_get_num_procs());
+  m_s->cores = omp_get_num_procs();
+  m_s->spins = spinsFor(threads, m_s->cores);
 }
 
 void ThreadTeam::dispatch(Job job, const void* body) {

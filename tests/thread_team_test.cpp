@@ -1,9 +1,9 @@
 // The team of the step's loops (core/thread_team.hpp): every loop runs its body once on every thread of the team,
 // forked or held; a held loop returns only when every thread has finished it and what they wrote is visible;
 // OpenMP barriers and worksharing inside a held body bind to the held team; a driver's exception leaves the hold
-// with the team released; a hold inside a hold is the outer one; and ThreadMax is the maximum of what the
-// threads put. That a run's bits do not depend on the team is checked by tests/determinism_test.cpp and
-// tests/fused_run_test.cpp, whose runs hold their teams.
+// with the team released; a hold inside a hold is the outer one; a hold reads the cores once; and ThreadMax is the
+// maximum of what the threads put. That a run's bits do not depend on the team is checked by
+// tests/determinism_test.cpp and tests/fused_run_test.cpp, whose runs hold their teams.
 #include <gtest/gtest.h>
 
 #include <omp.h>
@@ -165,6 +165,19 @@ TEST(ThreadTeam, HoldInsideAHoldIsTheOuterOne) {
   EXPECT_EQ(counts[0].calls, 1);
   EXPECT_EQ(counts[1].calls, 1);
   EXPECT_EQ(team.held(), 0);
+}
+
+// The cores the pass's waits count with: read once when a hold begins (the step asks for them every pass, and
+// omp_get_num_procs is a system call when the threads are not bound), and the same as outside it.
+TEST(ThreadTeam, CoresAreTheProcessorsAvailableInsideAndOutsideAHold) {
+  ThreadTeam team;
+  const int procs = omp_get_num_procs();
+  EXPECT_EQ(team.cores(), procs);
+  int inside = -1;
+  team.hold(2, [&] { inside = team.cores(); });
+  EXPECT_EQ(inside, procs);
+  EXPECT_EQ(team.held(), 0);
+  EXPECT_EQ(team.cores(), procs);
 }
 
 TEST(ThreadTeam, ThreadMaxIsTheLargestPut) {
