@@ -65,6 +65,8 @@ struct Options {
   bool settledSkin = false;  // --skin settled: fixed at the automatic skin's settled value (settledSkin below)
   std::array<int, 3> tile{1, 1, 1};  // periodic replicas of the packing per axis
   bool evenShares = false;  // --shares even: equal shares, not measured ones (core/share_balance.hpp)
+  // --interleave B: one simulation per thread count, run in turn for --steps steps each, B times (interleaved)
+  int bursts = 0;
   // particle order: Z-order (core/spatial_order.hpp), the cached packing's, or a seeded random permutation
   // (what a packing imported in arbitrary order would run at, were it not sorted)
   enum class Order { Morton, File, Shuffled } order = Order::Morton;
@@ -74,7 +76,7 @@ struct Options {
   std::fprintf(stderr,
                "bench_dense: %s\nusage: bench_dense [--threads 1,2] [--steps N] [--repeats N] [--cache FILE]\n"
                "                   [--export-lammps FILE] [--no-energy] [--skin METRES|settled] [--order file|morton|shuffled]\n"
-               "                   [--tile NX,NY,NZ] [--shares measured|even]\n",
+               "                   [--tile NX,NY,NZ] [--shares measured|even] [--interleave BURSTS]\n",
                msg);
   std::exit(2);
 }
@@ -122,6 +124,9 @@ Options parse(int argc, char** argv) {
       const std::string v = value();
       if (v != "measured" && v != "even") usage("--shares takes measured or even");
       o.evenShares = v == "even";
+    } else if (a == "--interleave") {
+      o.bursts = std::atoi(value().c_str());
+      if (o.bursts < 2) usage("--interleave takes a number of bursts >= 2");
     } else if (a == "-h" || a == "--help") {
       usage("help");
     } else {
@@ -290,6 +295,55 @@ double median(std::vector<double> v) {
 
 }  // namespace
 
+// --interleave: the speed-up of each thread count over the first, burst by burst. One simulation per thread count
+// runs --steps steps in turn with the others (the order alternating between bursts), so every burst compares the
+// same state (the runs keep the same bits) within a second of host time: the shared VMs' speed drifts by 20-40 %
+// within minutes, which separate runs (bench/two_cores.sh, bench/scaling.sh) see as spread. The median of the
+// bursts' ratios is printed, with its quartiles.
+int interleaved(const Simulation& prepared, const Options& o, std::size_t n) {
+  std::vector<Simulation> sims;
+  for (int t : o.threads) sims.push_back(measuredScene(prepared, t, o));
+  const std::size_t nt = sims.size();
+  std::vector<std::vector<double>> rates(nt), ratios(nt);
+  std::printf("interleaved: %d bursts of %ld steps per thread count\n", o.bursts, o.steps);
+  for (int b = 0; b < o.bursts; ++b) {
+    std::vector<double> rate(nt);
+    for (std::size_t q = 0; q < nt; ++q) {
+      const std::size_t k = b % 2 == 0 ? q : nt - 1 - q;
+      const auto t0 = std::chrono::steady_clock::now();
+      sims[k].run(o.steps);
+      rate[k] = static_cast<double>(n) * static_cast<double>(o.steps) / seconds(t0);
+    }
+    std::printf("burst %3d:", b + 1);
+    for (std::size_t k = 0; k < nt; ++k) {
+      rates[k].push_back(rate[k]);
+      ratios[k].push_back(rate[k] / rate[0]);
+      std::printf("  %d thread(s) %.4e", o.threads[k], rate[k]);
+    }
+    if (nt > 1) std::printf("  speed-up %.3f", rate[nt - 1] / rate[0]);
+    std::printf("\n");
+  }
+  bool same = true;
+  for (std::size_t k = 1; k < nt; ++k)
+    same = same && std::memcmp(sims[k].particles().pos.data(), sims[0].particles().pos.data(), n * sizeof(Vec3)) == 0;
+  std::printf("final positions bit-identical across thread counts: %s\n", same ? "yes" : "NO");
+  const auto quantile = [](std::vector<double> v, double f) {
+    std::sort(v.begin(), v.end());
+    const double x = f * static_cast<double>(v.size() - 1);
+    const auto i = static_cast<std::size_t>(x);
+    return i + 1 < v.size() ? v[i] + (x - static_cast<double>(i)) * (v[i + 1] - v[i]) : v[i];
+  };
+  for (std::size_t k = 0; k < nt; ++k) {
+    std::printf("result-interleaved: threads=%d rate=%.6e", o.threads[k], quantile(rates[k], 0.5));
+    if (k > 0)
+      std::printf(" speedup_vs_%d=%.3f q1=%.3f q3=%.3f min=%.3f max=%.3f", o.threads[0], quantile(ratios[k], 0.5),
+                  quantile(ratios[k], 0.25), quantile(ratios[k], 0.75), quantile(ratios[k], 0.0),
+                  quantile(ratios[k], 1.0));
+    std::printf(" bursts=%d steps=%ld N=%zu\n", o.bursts, o.steps, n);
+  }
+  return same ? 0 : 1;
+}
+
 int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress lines appear at once when piped (tee)
   Options o = parse(argc, argv);
@@ -322,6 +376,8 @@ int main(int argc, char** argv) {
                   settledSkin(prepared, o), s0.timeStep(), p0, counts.coordination);
     }
   }
+
+  if (o.bursts > 0) return interleaved(prepared, o, n);
 
   struct Result {
     int threads;
