@@ -327,6 +327,7 @@ int interleaved(const Simulation& prepared, const Options& o, std::size_t n) {
   for (std::size_t k = 1; k < nt; ++k)
     same = same && std::memcmp(sims[k].particles().pos.data(), sims[0].particles().pos.data(), n * sizeof(Vec3)) == 0;
   std::printf("final positions bit-identical across thread counts: %s\n", same ? "yes" : "NO");
+  // the f-quantile of v, linear between ranks (median() is its f = 0.5)
   const auto quantile = [](std::vector<double> v, double f) {
     std::sort(v.begin(), v.end());
     const double x = f * static_cast<double>(v.size() - 1);
@@ -334,7 +335,7 @@ int interleaved(const Simulation& prepared, const Options& o, std::size_t n) {
     return i + 1 < v.size() ? v[i] + (x - static_cast<double>(i)) * (v[i + 1] - v[i]) : v[i];
   };
   for (std::size_t k = 0; k < nt; ++k) {
-    std::printf("result-interleaved: threads=%d rate=%.6e", o.threads[k], quantile(rates[k], 0.5));
+    std::printf("result-interleaved: threads=%d rate=%.6e", o.threads[k], median(rates[k]));
     if (k > 0)
       std::printf(" speedup_vs_%d=%.3f q1=%.3f q3=%.3f min=%.3f max=%.3f", o.threads[0], quantile(ratios[k], 0.5),
                   quantile(ratios[k], 0.25), quantile(ratios[k], 0.75), quantile(ratios[k], 0.0),
