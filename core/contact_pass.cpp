@@ -117,7 +117,9 @@ void Simulation::contactPassBlocked() {
   if (!m_c.touchedValid) m_c.markTouched();  // after a rebuild, a restore or the other law's pass
   m_ranges.reset(m_boundary.chunkBegin, 1);  // contactPass made the shares (updateShares)
   int team = 0;
-  const std::uint64_t round = m_haloProgress.beginRound(m_num.threads, m_team.cores());
+  // the cores set how long a wait spins (spin_wait.hpp): one thread never waits, and asks nothing (a system call)
+  const int cores = m_num.threads > 1 ? m_team.cores() : 1;
+  const std::uint64_t round = m_haloProgress.beginRound(m_num.threads, cores);
   const auto loop = [this, &team, round](const int t, const int nt) {
     if (t == 0) team = nt;
     // locals of each thread, which no store of the pass can alias (kickPass)
