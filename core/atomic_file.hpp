@@ -5,9 +5,12 @@
 // system), the file is fsync'ed, renamed over <path>, and the directory is fsync'ed so the rename
 // itself is durable. On failure the temporary file is removed and IoError names the path and cause.
 // AppendLog: a record-by-record time series. Each append() writes one whole line and fflush'es it, so a
-// killed process loses at most the partial last line (the kernel keeps what was flushed); no fsync per
+// killed process loses at most its last record, which may be left as an unfinished last line (the kernel
+// keeps what was flushed); readers ignore that line and the next AppendLog on the file drops it. No fsync per
 // record, which would cost a disk round trip every sample.
 #pragma once
+
+#include <sys/types.h>  // off_t
 
 #include <cstdio>
 #include <string>
@@ -20,7 +23,8 @@ void writeFileAtomically(const std::string& path, const std::string& contents);
 class AppendLog {
  public:
   // Opens <path> for appending; a new or empty file first gets <header> as its first line. If an
-  // existing file ends in a partial line (a killed run), a newline is added so records stay separate.
+  // existing file ends in an unfinished line (a run killed inside a write), that line is removed, so every
+  // line holds one whole record.
   // Throws IoError naming the path if the file cannot be opened or written.
   AppendLog(std::string path, const std::string& header);
   ~AppendLog();
@@ -35,6 +39,7 @@ class AppendLog {
 
  private:
   void writeOrThrow(const std::string& text);
+  off_t completeLength(off_t size);  // bytes up to and including the file's last newline
 
   std::string m_path;
   std::FILE* m_file = nullptr;

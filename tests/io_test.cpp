@@ -191,11 +191,39 @@ TEST(AtomicFile, AppendLogWritesTheHeaderOnceAndEveryLineAtOnce) {
     log.append("0,1");
     EXPECT_EQ(slurp(path), "t,p\n0,1\n");  // flushed, not waiting for close
   }
-  spit(path, slurp(path) + "1,2.5");  // a run killed inside a record
+  // a run killed inside a record: the kernel kept "1,2.5" of "1,2.5e-3\n". Kept and terminated, it would be a
+  // well-formed row with a wrong number; it is dropped
+  spit(path, slurp(path) + "1,2.5");
   AppendLog log(path, "t,p");
   log.append("2,3");
-  EXPECT_EQ(slurp(path), "t,p\n0,1\n1,2.5\n2,3\n");
+  EXPECT_EQ(slurp(path), "t,p\n0,1\n2,3\n");
   EXPECT_THROW(AppendLog(dir / "missing/series.csv", "t"), IoError);
+}
+
+TEST(AtomicFile, AppendLogDropsAnUnfinishedLineAcrossBlocksAndAnUnfinishedHeader) {
+  TempDir dir;
+  const std::string path = dir / "series.csv";
+  // the unfinished line longer than the 4096-byte block read back from the end
+  const std::string done = "t,p\n0,1\n";
+  spit(path, done + std::string(9000, '7'));
+  {
+    AppendLog log(path, "t,p");
+    log.append("1,2");
+  }
+  EXPECT_EQ(slurp(path), done + "1,2\n");
+  // killed inside the header of a new file: the header is written again, whole
+  spit(path, "t,");
+  {
+    AppendLog log(path, "t,p");
+    log.append("0,1");
+  }
+  EXPECT_EQ(slurp(path), "t,p\n0,1\n");
+  // a file that ends with its newline is left as it is
+  {
+    AppendLog log(path, "t,p");
+    log.append("1,2");
+  }
+  EXPECT_EQ(slurp(path), "t,p\n0,1\n1,2\n");
 }
 
 // ---- packing CSV ----------------------------------------------------------------------------------
