@@ -3,7 +3,8 @@
 // tracked) the dissipated energies summed per fixed chunk of pairs in the same pass. The default law runs
 // vectorised over blocks of touching pairs (contact_block.hpp) and leaves the diagnostics' extremes and mean
 // force and the elastic energies to measureContacts, which reads them off the stored contacts when asked for;
-// the Mindlin–Deresiewicz law runs one pair at a time (mindlin_deresiewicz.hpp) and sums them all itself.
+// the Mindlin–Deresiewicz law runs vectorised over blocks of touching pairs too (mindlin_deresiewicz_block.hpp)
+// and sums them all itself.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -16,6 +17,7 @@
 #include "contact_block.hpp"
 #include "contact_kernels.hpp"
 #include "mindlin_deresiewicz.hpp"
+#include "mindlin_deresiewicz_block.hpp"
 #include "simulation.hpp"
 #include "streaming_store.hpp"
 
@@ -383,6 +385,11 @@ void Simulation::contactPassBlocked() {
 
 template <bool kEnergy, bool kDamping, bool kAffine>
 void Simulation::contactPassMindlinDeresiewicz() {
+  // Per block of up to kBlockPairs listed pairs, all within one reduction chunk (so the bits do not depend on
+  // the thread count): 1. the geometry and the normal force pair by pair, the touching pairs' law inputs and
+  // history gathered into an MdBlock; 2. the tangential law, vectorised across the block
+  // (kernels::mindlinDeresiewiczBlock), the pairs it flags run through the scalar kernel from their unchanged
+  // history; 3. history and results scattered back and the chunk's sums added, in pair order.
   m_c.touchedValid = false;  // this pass changes the history without ContactStore::touched
   m_seedsReady = false;      // nor does it sum the seeds: the kick reads every entry
   updateShares();
@@ -397,87 +404,113 @@ void Simulation::contactPassMindlinDeresiewicz() {
   MdHistory* mdHist = m_c.mdHistory.data();
   const PairTable& table = m_pairs;
   Chunk* chunks = m_chunks.data();
+  kernels::MdBlock b{};  // per thread, ~22 KiB: stays in L1 through the three phases
+  // what phase 3 needs of each slot besides the law's results
+  struct Slot {
+    std::int32_t pair;
+    double dx, dy, dz;     // branch vector [m]
+    double delta, fe, fn;  // overlap [m], elastic and total normal force [N]
+    double kn;             // 2 E* a [N/m]
+    double mstar, dampPower, dampingRatio;  // damping only
+    double overlapRatio, invMassSum;        // delta / min(r_i, r_j), 1/m_i + 1/m_j
+  };
+  Slot slots[kernels::kBlockPairs];
   ThreadRuns runs(m_ranges, t, nt, nchunks);
   for (std::size_t runBegin, runEnd; runs.next(runBegin, runEnd);)
   for (std::size_t k = runBegin; k < runEnd; ++k) {
     Chunk acc;
     const std::size_t end = std::min(np, (k + 1) * kChunk);
-    for (std::size_t p = k * kChunk; p < end; ++p) {
-      const int i = arr.first[p], j = arr.second[p];
-      const Vec3 d = arr.branch(p, i, j);
-      const double ri = pass[i].radius, rj = pass[j].radius;
-      const double R = ri + rj;
-      const double dist2 = d.squaredNorm();
-      if (dist2 >= R * R) {
-        // not touching: results and history are zero (the kick gathers the zero force unconditionally)
-        if (arr.hist[p].contactRadius != 0.0) {  // a touching pair always has a > 0 (see contactPassBlocked)
-          arr.result[p] = PairResult{};
-          arr.hist[p] = ContactHistory{};
-          // the contact opened: its locked micro-slip energy is dissipated
-          if constexpr (kEnergy) acc.friction += mdHist[p].locked;
-          mdHist[p] = MdHistory{};
+    for (std::size_t p0 = k * kChunk; p0 < end; p0 += kernels::kBlockPairs) {
+      // 1. geometry and normal force; the touching pairs into the block
+      int m = 0;
+      for (std::size_t p = p0, p1 = std::min(end, p0 + kernels::kBlockPairs); p < p1; ++p) {
+        const int i = arr.first[p], j = arr.second[p];
+        const Vec3 d = arr.branch(p, i, j);
+        const double ri = pass[i].radius, rj = pass[j].radius;
+        const double R = ri + rj;
+        const double dist2 = d.squaredNorm();
+        if (dist2 >= R * R) {
+          // not touching: results and history are zero (the kick gathers the zero force unconditionally)
+          if (arr.hist[p].contactRadius != 0.0) {  // a touching pair always has a > 0 (see contactPassBlocked)
+            arr.result[p] = PairResult{};
+            arr.hist[p] = ContactHistory{};
+            // the contact opened: its locked micro-slip energy is dissipated
+            if constexpr (kEnergy) acc.friction += mdHist[p].locked;
+            mdHist[p] = MdHistory{};
+          }
+          continue;
         }
-        continue;
-      }
-      const double dist = std::sqrt(dist2);
-      const double invDist = 1.0 / dist;
-      const Vec3 n = d * invDist;
-      const double delta = R - dist;
-      const double li = ri - 0.5 * delta, lj = rj - 0.5 * delta;
-      // relative velocity of j's contact point w.r.t. i's, including the mean field L·l, which carries the
-      // image shift velocity L·H·n for pairs across the boundary (verification ladder §2)
-      Vec3 vrel = pass[j].v - pass[i].v - (lj * arr.w[j] + li * arr.w[i]).cross(n);
-      if constexpr (kAffine) vrel += L * d;
-      const double vn = vrel.dot(n);
-      const Vec3 vt = vrel - vn * n;
-      const PairParams& pp = table(arr.mat[i], arr.mat[j]);
-      const double Rstar = ri * rj / R;
-      const double a = std::sqrt(Rstar * delta);
-      const double fe = kernels::hertzForce(pp.effYoung, a, delta);
-      double fn = fe;
-      const double kn = kernels::hertzStiffness(pp.effYoung, a);
-      double dampPower = 0.0;
-      double mstar = 0.0;
-      if constexpr (kDamping) {
-        mstar = 1.0 / (pass[i].invMass + pass[j].invMass);
-        const double cn = kernels::dampingCoefficient(pp.dampingRatio, kn, mstar);
-        fn = std::max(0.0, fe - cn * vn);  // no attraction
-        dampPower += (fe - fn) * vn;       // = cn vn^2 unless clamped
-      }
-      // tangential law: elastic force, stiffness k_t (time step, damping), stored energy and dissipation
-      Vec3 ftElastic;
-      double kt, storedT, dissipatedT;
-      bool sliding;
-      {
-        const auto tr = kernels::mindlinDeresiewicz(n, vt, a, fn, pp.effShear, pp.friction, dt, arr.hist[p], mdHist[p]);
-        ftElastic = tr.force;
-        kt = tr.stiffness;
-        sliding = tr.sliding;
-        storedT = tr.storedEnergy;
-        dissipatedT = tr.slipWork + tr.microSlipWork;
-      }
-      Vec3 ft = ftElastic;
-      if constexpr (kDamping) {
-        if (!sliding) {
-          const Vec3 fd = -kernels::dampingCoefficient(pp.dampingRatio, kt, mstar) * vt;
-          ft += fd;
-          dampPower -= fd.dot(vt);
+        const double dist = std::sqrt(dist2);
+        const double invDist = 1.0 / dist;
+        const Vec3 n = d * invDist;
+        const double delta = R - dist;
+        const double li = ri - 0.5 * delta, lj = rj - 0.5 * delta;
+        // relative velocity of j's contact point w.r.t. i's, including the mean field L·l, which carries the
+        // image shift velocity L·H·n for pairs across the boundary (verification ladder §2)
+        Vec3 vrel = pass[j].v - pass[i].v - (lj * arr.w[j] + li * arr.w[i]).cross(n);
+        if constexpr (kAffine) vrel += L * d;
+        const double vn = vrel.dot(n);
+        const Vec3 vt = vrel - vn * n;
+        const PairParams& pp = table(arr.mat[i], arr.mat[j]);
+        const double Rstar = ri * rj / R;
+        const double a = std::sqrt(Rstar * delta);
+        const double fe = kernels::hertzForce(pp.effYoung, a, delta);
+        double fn = fe;
+        const double kn = kernels::hertzStiffness(pp.effYoung, a);
+        double dampPower = 0.0;
+        double mstar = 0.0;
+        const double invMassSum = pass[i].invMass + pass[j].invMass;
+        if constexpr (kDamping) {
+          mstar = 1.0 / invMassSum;
+          const double cn = kernels::dampingCoefficient(pp.dampingRatio, kn, mstar);
+          fn = std::max(0.0, fe - cn * vn);  // no attraction
+          dampPower += (fe - fn) * vn;       // = cn vn^2 unless clamped
         }
+        slots[m] = {static_cast<std::int32_t>(p), d.x(), d.y(), d.z(), delta, fe, fn, kn, mstar, dampPower,
+                    pp.dampingRatio, delta / std::min(ri, rj), invMassSum};
+        kernels::mdGather(b, m, n, vt, a, fn, pp.effShear, pp.friction, arr.hist[p], mdHist[p]);
+        ++m;
       }
-      const Vec3 f = fn * n + ft;
-      arr.result[p] = {f, n.cross(f), delta, fn};
-      acc.stress.noalias() += f * d.transpose();
-      acc.stiffness += kn * n.cwiseProduct(d).cwiseAbs2();
-      acc.sumForce += f.norm();
-      ++acc.contacts;
-      acc.sliding += sliding;
-      acc.maxOverlapRatio = std::max(acc.maxOverlapRatio, delta / std::min(ri, rj));
-      acc.maxKOverM = std::max(acc.maxKOverM, std::max(kn, 3.5 * kt) * (pass[i].invMass + pass[j].invMass));
-      if constexpr (kEnergy) {
-        acc.elasticN += kernels::hertzEnergy(fe, delta);
-        acc.elasticT += storedT;
-        acc.friction += dissipatedT;
-        acc.damping += dampPower * dt;
+      if (m == 0) continue;
+      // 2. the tangential law across the block
+      b.count = m;
+      kernels::mindlinDeresiewiczBlock(b, dt);
+      // 3. in pair order: history (the scalar kernel where the block flagged a pair), results and sums
+      for (int s = 0; s < m; ++s) {
+        const Slot& q = slots[s];
+        const std::size_t p = static_cast<std::size_t>(q.pair);
+        const Vec3 n(b.nx[s], b.ny[s], b.nz[s]);
+        const Vec3 vt(b.vtx[s], b.vty[s], b.vtz[s]);
+        // tangential law: elastic force, stiffness k_t (time step, damping), stored energy and dissipation
+        const kernels::MdSlotResult tr = kernels::mdScatter(b, s, dt, arr.hist[p], mdHist[p]);
+        const double kt = kernels::mindlinStiffness(b.effShear[s], b.a[s]);
+        const bool sliding = tr.sliding;
+        Vec3 ft = tr.force;
+        double dampPower = q.dampPower;
+        if constexpr (kDamping) {
+          if (!sliding) {
+            const Vec3 fd = -kernels::dampingCoefficient(q.dampingRatio, kt, q.mstar) * vt;
+            ft += fd;
+            dampPower -= fd.dot(vt);
+          }
+        }
+        const Vec3 d(q.dx, q.dy, q.dz);
+        const double fn = q.fn, kn = q.kn;
+        const Vec3 f = fn * n + ft;
+        arr.result[p] = {f, n.cross(f), q.delta, fn};
+        acc.stress.noalias() += f * d.transpose();
+        acc.stiffness += kn * n.cwiseProduct(d).cwiseAbs2();
+        acc.sumForce += f.norm();
+        ++acc.contacts;
+        acc.sliding += sliding;
+        acc.maxOverlapRatio = std::max(acc.maxOverlapRatio, q.overlapRatio);
+        acc.maxKOverM = std::max(acc.maxKOverM, std::max(kn, 3.5 * kt) * q.invMassSum);
+        if constexpr (kEnergy) {
+          acc.elasticN += kernels::hertzEnergy(q.fe, q.delta);
+          acc.elasticT += tr.storedEnergy;
+          acc.friction += tr.dissipated;
+          acc.damping += dampPower * dt;
+        }
       }
     }
     chunks[k] = acc;
