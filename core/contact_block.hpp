@@ -41,7 +41,7 @@ struct alignas(64) PairBlock {
   alignas(64) double vx[kBlockPairs], vy[kBlockPairs], vz[kBlockPairs];  // v_j - v_i (+ L d) [m/s]
   alignas(64) double wix[kBlockPairs], wiy[kBlockPairs], wiz[kBlockPairs];  // omega_i [rad/s]
   alignas(64) double wjx[kBlockPairs], wjy[kBlockPairs], wjz[kBlockPairs];  // omega_j [rad/s]
-  alignas(64) double invMassSum[kBlockPairs];  // 1/m_i + 1/m_j [1/kg], read only with damping
+  alignas(64) double invMassSum[kBlockPairs];  // 1/m_i + 1/m_j [1/kg], read only with damping (and mdBlockSums)
   alignas(64) double effYoung[kBlockPairs], effShear[kBlockPairs];       // E*, G* [Pa]
   alignas(64) double friction[kBlockPairs], dampingRatio[kBlockPairs];   // mu, beta [-]
   // ---- history: in and out (ContactHistory)
@@ -74,19 +74,12 @@ struct BlockSums {
   double dissipatedT = 0.0, dampPower = 0.0;  // [J], [W]
 };
 
-// Hertz normal force, Tsuji damping (kDamping) and the incremental Mindlin no-slip spring with Coulomb cap,
-// for b.count pairs. See contact_kernels.hpp for the law and its energy bookkeeping (Thornton et al. 2011).
-// kEnergy: also write the energy terms (dissipatedT, dampPower); without it they are left unwritten, and what
-// only they need (the compliance 1/k_t among it) is dead code the compiler removes.
-template <bool kDamping, bool kEnergy>
-inline void hertzMindlinBlock(PairBlock& b, double dt) {
+// The normal contact of b.count pairs (the first loop of hertzMindlinBlock, which the Mindlin–Deresiewicz pass
+// runs too): unit normal, overlap, contact radius, Hertz force and stiffness, the tangential velocity and
+// (kDamping) the Tsuji damping of the normal force, its power and the reduced mass.
+template <bool kDamping>
+inline void hertzNormalBlock(PairBlock& b) {
   const int m = (b.count + kSimdSlots - 1) / kSimdSlots * kSimdSlots;  // padding: see kSimdSlots
-  // Three loops: the normal contact; the stored spring's rotation and unloading; its increment, the Coulomb
-  // cap and the forces. Each pair's law is one long chain of square roots and divisions; in one loop of ~270
-  // instructions the out-of-order window held about one iteration, so the chains of consecutive vectors
-  // hardly overlapped (AVX2: four pairs a vector), and the values live across it spilled to the stack. Short
-  // loops overlap several iterations; what passes between them goes through the block (L1). bench_block_law
-  // (no damping, energy terms, Zen 3): 14.1 ns a pair as two loops with vector selects, 12.6 as these three.
 #pragma omp simd
   for (int s = 0; s < m; ++s) {
     const double d = std::sqrt(b.dist2[s]);
@@ -128,6 +121,22 @@ inline void hertzMindlinBlock(PairBlock& b, double dt) {
     b.fn[s] = fn;
     b.kn[s] = kn;
   }
+}
+
+// Hertz normal force, Tsuji damping (kDamping) and the incremental Mindlin no-slip spring with Coulomb cap,
+// for b.count pairs. See contact_kernels.hpp for the law and its energy bookkeeping (Thornton et al. 2011).
+// kEnergy: also write the energy terms (dissipatedT, dampPower); without it they are left unwritten, and what
+// only they need (the compliance 1/k_t among it) is dead code the compiler removes.
+template <bool kDamping, bool kEnergy>
+inline void hertzMindlinBlock(PairBlock& b, double dt) {
+  const int m = (b.count + kSimdSlots - 1) / kSimdSlots * kSimdSlots;  // padding: see kSimdSlots
+  // Three loops: the normal contact; the stored spring's rotation and unloading; its increment, the Coulomb
+  // cap and the forces. Each pair's law is one long chain of square roots and divisions; in one loop of ~270
+  // instructions the out-of-order window held about one iteration, so the chains of consecutive vectors
+  // hardly overlapped (AVX2: four pairs a vector), and the values live across it spilled to the stack. Short
+  // loops overlap several iterations; what passes between them goes through the block (L1). bench_block_law
+  // (no damping, energy terms, Zen 3): 14.1 ns a pair as two loops with vector selects, 12.6 as these three.
+  hertzNormalBlock<kDamping>(b);
   // Mindlin no-slip spring (mindlinNoSlip): 1. rotate into the tangent plane, 2. scale on unloading,
   // 3. increment, 4. Coulomb cap
 #pragma omp simd

@@ -386,10 +386,11 @@ void Simulation::contactPassBlocked() {
 template <bool kEnergy, bool kDamping, bool kAffine>
 void Simulation::contactPassMindlinDeresiewicz() {
   // Per block of up to kBlockPairs listed pairs, all within one reduction chunk (so the bits do not depend on
-  // the thread count): 1. the geometry and the normal force pair by pair, the touching pairs' law inputs and
-  // history gathered into an MdBlock; 2. the tangential law, vectorised across the block
-  // (kernels::mindlinDeresiewiczBlock), the pairs it flags run through the scalar kernel from their unchanged
-  // history; 3. history and results scattered back and the chunk's sums added, in pair order.
+  // the thread count): 1. the branch vector pair by pair, the touching pairs' inputs and history gathered into
+  // a PairBlock and an MdBlock; 2. the normal contact (kernels::hertzNormalBlock, as the default law's) and
+  // the tangential law (kernels::mindlinDeresiewiczBlock), vectorised across the block; 3. in pair order the
+  // history and results scattered back (the pairs the law flags through the scalar kernel, from their
+  // unchanged history), then the block's sums (kernels::blockSums, kernels::mdBlockMeasures), vectorised.
   m_c.touchedValid = false;  // this pass changes the history without ContactStore::touched
   m_seedsReady = false;      // nor does it sum the seeds: the kick reads every entry
   updateShares();
@@ -404,24 +405,16 @@ void Simulation::contactPassMindlinDeresiewicz() {
   MdHistory* mdHist = m_c.mdHistory.data();
   const PairTable& table = m_pairs;
   Chunk* chunks = m_chunks.data();
-  kernels::MdBlock b{};  // per thread, ~22 KiB: stays in L1 through the three phases
-  // what phase 3 needs of each slot besides the law's results
-  struct Slot {
-    std::int32_t pair;
-    double dx, dy, dz;     // branch vector [m]
-    double delta, fe, fn;  // overlap [m], elastic and total normal force [N]
-    double kn;             // 2 E* a [N/m]
-    double mstar, dampPower, dampingRatio;  // damping only
-    double overlapRatio, invMassSum;        // delta / min(r_i, r_j), 1/m_i + 1/m_j
-  };
-  Slot slots[kernels::kBlockPairs];
+  kernels::PairBlock g{};  // per thread, ~23 + 19 KiB: the geometry and the law's state stay in L1
+  kernels::MdBlock b{};
+  std::int32_t index[kernels::kBlockPairs];  // pair of each slot
   ThreadRuns runs(m_ranges, t, nt, nchunks);
   for (std::size_t runBegin, runEnd; runs.next(runBegin, runEnd);)
   for (std::size_t k = runBegin; k < runEnd; ++k) {
     Chunk acc;
     const std::size_t end = std::min(np, (k + 1) * kChunk);
     for (std::size_t p0 = k * kChunk; p0 < end; p0 += kernels::kBlockPairs) {
-      // 1. geometry and normal force; the touching pairs into the block
+      // 1. the touching pairs into the blocks
       int m = 0;
       for (std::size_t p = p0, p1 = std::min(end, p0 + kernels::kBlockPairs); p < p1; ++p) {
         const int i = arr.first[p], j = arr.second[p];
@@ -440,77 +433,75 @@ void Simulation::contactPassMindlinDeresiewicz() {
           }
           continue;
         }
-        const double dist = std::sqrt(dist2);
-        const double invDist = 1.0 / dist;
-        const Vec3 n = d * invDist;
-        const double delta = R - dist;
-        const double li = ri - 0.5 * delta, lj = rj - 0.5 * delta;
-        // relative velocity of j's contact point w.r.t. i's, including the mean field L·l, which carries the
-        // image shift velocity L·H·n for pairs across the boundary (verification ladder §2)
-        Vec3 vrel = pass[j].v - pass[i].v - (lj * arr.w[j] + li * arr.w[i]).cross(n);
-        if constexpr (kAffine) vrel += L * d;
-        const double vn = vrel.dot(n);
-        const Vec3 vt = vrel - vn * n;
+        // v_j - v_i, with the mean field L·l, which carries the image shift velocity L·H·n for pairs across the
+        // boundary (verification ladder §2); the spins' part is hertzNormalBlock's
+        Vec3 v = pass[j].v - pass[i].v;
+        if constexpr (kAffine) v += L * d;
+        const Vec3& wi = arr.w[i];
+        const Vec3& wj = arr.w[j];
         const PairParams& pp = table(arr.mat[i], arr.mat[j]);
-        const double Rstar = ri * rj / R;
-        const double a = std::sqrt(Rstar * delta);
-        const double fe = kernels::hertzForce(pp.effYoung, a, delta);
-        double fn = fe;
-        const double kn = kernels::hertzStiffness(pp.effYoung, a);
-        double dampPower = 0.0;
-        double mstar = 0.0;
-        const double invMassSum = pass[i].invMass + pass[j].invMass;
-        if constexpr (kDamping) {
-          mstar = 1.0 / invMassSum;
-          const double cn = kernels::dampingCoefficient(pp.dampingRatio, kn, mstar);
-          fn = std::max(0.0, fe - cn * vn);  // no attraction
-          dampPower += (fe - fn) * vn;       // = cn vn^2 unless clamped
-        }
-        slots[m] = {static_cast<std::int32_t>(p), d.x(), d.y(), d.z(), delta, fe, fn, kn, mstar, dampPower,
-                    pp.dampingRatio, delta / std::min(ri, rj), invMassSum};
-        kernels::mdGather(b, m, n, vt, a, fn, pp.effShear, pp.friction, arr.hist[p], mdHist[p]);
+        g.dx[m] = d.x(), g.dy[m] = d.y(), g.dz[m] = d.z();
+        g.dist2[m] = dist2;
+        g.ri[m] = ri, g.rj[m] = rj;
+        g.vx[m] = v.x(), g.vy[m] = v.y(), g.vz[m] = v.z();
+        g.wix[m] = wi.x(), g.wiy[m] = wi.y(), g.wiz[m] = wi.z();
+        g.wjx[m] = wj.x(), g.wjy[m] = wj.y(), g.wjz[m] = wj.z();
+        g.invMassSum[m] = pass[i].invMass + pass[j].invMass;
+        g.effYoung[m] = pp.effYoung;
+        g.dampingRatio[m] = pp.dampingRatio;
+        b.effShear[m] = pp.effShear;
+        b.friction[m] = pp.friction;
+        kernels::mdGatherHistory(b, m, arr.hist[p], mdHist[p]);
+        index[m] = static_cast<std::int32_t>(p);
         ++m;
       }
       if (m == 0) continue;
-      // 2. the tangential law across the block
-      b.count = m;
+      // 2. the normal contact and the tangential law across the block
+      g.count = b.count = m;
+      kernels::hertzNormalBlock<kDamping>(g);
+      kernels::mdTakeGeometry(b, g.nx, g.ny, g.nz, g.vtx, g.vty, g.vtz, g.a, g.fn);
       kernels::mindlinDeresiewiczBlock(b, dt);
-      // 3. in pair order: history (the scalar kernel where the block flagged a pair), results and sums
+      // 3. in pair order: history (the scalar kernel where the block flagged a pair) and results
       for (int s = 0; s < m; ++s) {
-        const Slot& q = slots[s];
-        const std::size_t p = static_cast<std::size_t>(q.pair);
-        const Vec3 n(b.nx[s], b.ny[s], b.nz[s]);
-        const Vec3 vt(b.vtx[s], b.vty[s], b.vtz[s]);
-        // tangential law: elastic force, stiffness k_t (time step, damping), stored energy and dissipation
+        const std::size_t p = static_cast<std::size_t>(index[s]);
         const kernels::MdSlotResult tr = kernels::mdScatter(b, s, dt, arr.hist[p], mdHist[p]);
-        const double kt = kernels::mindlinStiffness(b.effShear[s], b.a[s]);
-        const bool sliding = tr.sliding;
+        const Vec3 n(g.nx[s], g.ny[s], g.nz[s]);
         Vec3 ft = tr.force;
-        double dampPower = q.dampPower;
         if constexpr (kDamping) {
-          if (!sliding) {
-            const Vec3 fd = -kernels::dampingCoefficient(q.dampingRatio, kt, q.mstar) * vt;
+          if (!tr.sliding) {
+            const Vec3 vt(g.vtx[s], g.vty[s], g.vtz[s]);
+            const double kt = kernels::mindlinStiffness(b.effShear[s], g.a[s]);
+            const Vec3 fd = -kernels::dampingCoefficient(g.dampingRatio[s], kt, g.reducedMass[s]) * vt;
             ft += fd;
-            dampPower -= fd.dot(vt);
+            g.dampPower[s] -= fd.dot(vt);
           }
+        } else {
+          g.dampPower[s] = 0.0;  // blockSums adds it with kEnergy
         }
-        const Vec3 d(q.dx, q.dy, q.dz);
-        const double fn = q.fn, kn = q.kn;
-        const Vec3 f = fn * n + ft;
-        arr.result[p] = {f, n.cross(f), q.delta, fn};
-        acc.stress.noalias() += f * d.transpose();
-        acc.stiffness += kn * n.cwiseProduct(d).cwiseAbs2();
-        acc.sumForce += f.norm();
-        ++acc.contacts;
-        acc.sliding += sliding;
-        acc.maxOverlapRatio = std::max(acc.maxOverlapRatio, q.overlapRatio);
-        acc.maxKOverM = std::max(acc.maxKOverM, std::max(kn, 3.5 * kt) * q.invMassSum);
-        if constexpr (kEnergy) {
-          acc.elasticN += kernels::hertzEnergy(q.fe, q.delta);
-          acc.elasticT += tr.storedEnergy;
-          acc.friction += tr.dissipated;
-          acc.damping += dampPower * dt;
-        }
+        const Vec3 f = g.fn[s] * n + ft;
+        arr.result[p] = {f, n.cross(f), g.delta[s], g.fn[s]};
+        g.fx[s] = f.x(), g.fy[s] = f.y(), g.fz[s] = f.z();
+        g.sliding[s] = tr.sliding ? 1.0 : 0.0;
+        g.dissipatedT[s] = tr.dissipated;
+        b.storedEnergy[s] = tr.storedEnergy;  // the scalar kernel's where it ran
+      }
+      // the block's sums: those of the default law (stress, stiffness, sliding, dissipation) and the measures
+      kernels::BlockSums sums;
+      kernels::blockSums<kEnergy>(g, sums);
+      kernels::MdBlockMeasures measures;
+      kernels::mdBlockMeasures<kEnergy>(g, b, measures);
+      acc.stress += Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(&sums.s[0][0]);
+      acc.stiffness += Vec3(sums.k[0], sums.k[1], sums.k[2]);
+      acc.contacts += static_cast<std::size_t>(m);
+      acc.sliding += static_cast<std::size_t>(sums.sliding);
+      acc.sumForce += measures.sumForce;
+      acc.maxOverlapRatio = std::max(acc.maxOverlapRatio, measures.maxOverlapRatio);
+      acc.maxKOverM = std::max(acc.maxKOverM, measures.maxKOverM);
+      if constexpr (kEnergy) {
+        acc.elasticN += measures.elasticN;
+        acc.elasticT += measures.elasticT;
+        acc.friction += sums.dissipatedT;
+        acc.damping += sums.dampPower * dt;
       }
     }
     chunks[k] = acc;

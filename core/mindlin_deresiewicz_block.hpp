@@ -209,15 +209,9 @@ inline void mindlinDeresiewiczBlock(MdBlock& b, double dt) {
 }
 
 // The caller's side, one pair at a time: its law inputs and history into slot s (the arguments of
-// kernels::mindlinDeresiewicz); after the block, mdScatter.
-inline void mdGather(MdBlock& b, int s, const Vec3& n, const Vec3& vt, double contactRadius, double normalForce,
-                     double effShear, double friction, const ContactHistory& h, const MdHistory& md) {
-  b.nx[s] = n.x(), b.ny[s] = n.y(), b.nz[s] = n.z();
-  b.vtx[s] = vt.x(), b.vty[s] = vt.y(), b.vtz[s] = vt.z();
-  b.a[s] = contactRadius;
-  b.fn[s] = normalForce;
-  b.effShear[s] = effShear;
-  b.friction[s] = friction;
+// kernels::mindlinDeresiewicz); after the block, mdScatter. The contact pass gathers the history here and
+// takes the geometry from the default law's normal-contact loop (mdTakeGeometry).
+inline void mdGatherHistory(MdBlock& b, int s, const ContactHistory& h, const MdHistory& md) {
   b.tx[s] = h.tangentialForce.x(), b.ty[s] = h.tangentialForce.y(), b.tz[s] = h.tangentialForce.z();
   b.aPrev[s] = h.contactRadius;
   b.lx[s] = md.turnLoad.x(), b.ly[s] = md.turnLoad.y(), b.lz[s] = md.turnLoad.z();
@@ -227,6 +221,29 @@ inline void mdGather(MdBlock& b, int s, const Vec3& n, const Vec3& vt, double co
   b.locked[s] = md.locked;
   b.branch[s] = static_cast<double>(md.branch);
 }
+inline void mdGather(MdBlock& b, int s, const Vec3& n, const Vec3& vt, double contactRadius, double normalForce,
+                     double effShear, double friction, const ContactHistory& h, const MdHistory& md) {
+  b.nx[s] = n.x(), b.ny[s] = n.y(), b.nz[s] = n.z();
+  b.vtx[s] = vt.x(), b.vty[s] = vt.y(), b.vtz[s] = vt.z();
+  b.a[s] = contactRadius;
+  b.fn[s] = normalForce;
+  b.effShear[s] = effShear;
+  b.friction[s] = friction;
+  mdGatherHistory(b, s, h, md);
+}
+// The normal, tangential velocity, contact radius and normal force of slots [0, b.count) (padded) from arrays
+// of a block's length (PairBlock's, after hertzNormalBlock).
+inline void mdTakeGeometry(MdBlock& b, const double* nx, const double* ny, const double* nz, const double* vtx,
+                           const double* vty, const double* vtz, const double* a, const double* fn) {
+  const int m = (b.count + kSimdSlots - 1) / kSimdSlots * kSimdSlots;
+#pragma omp simd
+  for (int s = 0; s < m; ++s) {
+    b.nx[s] = nx[s], b.ny[s] = ny[s], b.nz[s] = nz[s];
+    b.vtx[s] = vtx[s], b.vty[s] = vty[s], b.vtz[s] = vtz[s];
+    b.a[s] = a[s], b.fn[s] = fn[s];
+  }
+}
+
 // What the caller needs of a slot's step (kernels::MdResult's fields the contact pass reads).
 struct MdSlotResult {
   Vec3 force;          // F_t on j [N]
@@ -251,6 +268,39 @@ inline MdSlotResult mdScatter(const MdBlock& b, int s, double dt, ContactHistory
   md.locked = b.locked[s];
   md.branch = static_cast<MdBranch>(static_cast<int>(b.branch[s]));
   return {h.tangentialForce, b.storedEnergy[s], b.dissipated[s], b.sliding[s] != 0.0};
+}
+
+// What the diagnostics and the energy ledger take from a block besides blockSums (contact_block.hpp): the sum of
+// |f| and the extremes of ContactDiagnostics, and (kEnergy) the elastic energies. This law's pass sums them
+// itself: its stored tangential energy includes the locked energy L, which measureContacts cannot read off
+// the contacts.
+struct MdBlockMeasures {
+  double sumForce = 0.0, maxOverlapRatio = 0.0, maxKOverM = 0.0;  // [N], [-], [1/s^2]
+  double elasticN = 0.0, elasticT = 0.0;                          // [J]
+};
+// After the pass has written the forces (g.f{x,y,z}) and the slots' stored energy (b, the scalar kernel's where
+// it ran). Vectorised across the block's g.count pairs: a block's sums depend on its contents only, so a
+// chunk's do not depend on the thread count.
+template <bool kEnergy>
+inline void mdBlockMeasures(const PairBlock& g, const MdBlock& b, MdBlockMeasures& sums) {
+  double sumForce = 0.0, maxOverlap = 0.0, maxKOverM = 0.0, elasticN = 0.0, elasticT = 0.0;
+#pragma omp simd reduction(+ : sumForce, elasticN, elasticT) reduction(max : maxOverlap, maxKOverM)
+  for (int s = 0; s < g.count; ++s) {
+    const double fx = g.fx[s], fy = g.fy[s], fz = g.fz[s];
+    sumForce += std::sqrt(fx * fx + fy * fy + fz * fz);
+    maxOverlap = std::max(maxOverlap, g.delta[s] / std::min(g.ri[s], g.rj[s]));
+    const double kt = mindlinStiffness(b.effShear[s], g.a[s]);
+    maxKOverM = std::max(maxKOverM, std::max(g.kn[s], 3.5 * kt) * g.invMassSum[s]);
+    if constexpr (kEnergy) {
+      elasticN += hertzEnergy(hertzForce(g.effYoung[s], g.a[s], g.delta[s]), g.delta[s]);
+      elasticT += b.storedEnergy[s];
+    }
+  }
+  sums.sumForce += sumForce;
+  sums.maxOverlapRatio = std::max(sums.maxOverlapRatio, maxOverlap);
+  sums.maxKOverM = std::max(sums.maxKOverM, maxKOverM);
+  sums.elasticN += elasticN;
+  sums.elasticT += elasticT;
 }
 
 }  // namespace fl::kernels

@@ -195,7 +195,9 @@ class Simulation {
   // (thread_boundary.hpp); one thread pays no select
   template <bool kEnergy, bool kDamping, bool kAffine, bool kHalo>
   void contactPassBlocked();
-  // Mindlin–Deresiewicz law: one pair at a time (its branch history does not vectorise).
+  // Mindlin–Deresiewicz law: the normal contact as the default law's (hertzNormalBlock) and the tangential
+  // law vectorised over blocks of touching pairs (mindlin_deresiewicz_block.hpp), the rare pairs it flags
+  // through the scalar kernel.
   template <bool kEnergy, bool kDamping, bool kAffine>
   void contactPassMindlinDeresiewicz();
   // Sums the pass's chunk partials in chunk order into the stress, energies and diagnostics.
