@@ -4,7 +4,7 @@
 # lists all its stages is skipped). A step that nothing else can run beside (a specimen, the anisotropic
 # history) takes JOBS threads; the others run JOBS at a time, one thread each. Results do not depend on the
 # thread count (the same bits, tests/determinism_test.cpp).
-# Usage: scripts/paper-study.sh [JOBS]       (23 min on 2 Zen 4 cores, 54 min on Zen 3 before the servo fix; docs/performance.md)
+# Usage: scripts/paper-study.sh [JOBS]       (16 min on 2 AMD EPYC cores, 21-23 min on Zen 4 before the M–D law was vectorised; docs/performance.md)
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 jobs="${1:-$(nproc)}"
@@ -36,7 +36,7 @@ printf '%s\n' history-isotropic-isotropic history-isotropic-k0 history-isotropic
   xargs -P "$jobs" -I{} bash -c 'run_one {}' || failed=1
 run_one specimen-anisotropic "$jobs" || failed=1
 run_one history-anisotropic-isotropic "$jobs" || failed=1
-# The cyclic runs, longest first: the Mindlin–Deresiewicz runs (run-*-md, ~5x a no-slip run's time), then the
+# The cyclic runs, longest first: the Mindlin–Deresiewicz runs (run-*-md, ~2x a no-slip run's time), then the
 # others by name. Replayed with the eleventh session's run times (docs/performance.md) the two lanes finish
 # the runs in 1160 s this way against 1213 s by name alone (the tenth session's times, before the servo stopped
 # measuring every step, favoured the name order: 23.2 against 23.7 min).
