@@ -405,7 +405,7 @@ void Simulation::contactPassMindlinDeresiewicz() {
   MdHistory* mdHist = m_c.mdHistory.data();
   const PairTable& table = m_pairs;
   Chunk* chunks = m_chunks.data();
-  kernels::PairBlock g{};  // per thread, ~23 + 19 KiB: the geometry and the law's state stay in L1
+  kernels::PairBlock g{};  // per thread, ~23 + 15 KiB: the geometry and the law's state stay in L1
   kernels::MdBlock b{};
   std::int32_t index[kernels::kBlockPairs];  // pair of each slot
   ThreadRuns runs(m_ranges, t, nt, nchunks);

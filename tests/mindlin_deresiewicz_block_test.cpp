@@ -178,20 +178,21 @@ struct BlockContact {
     return kernels::mdScatter(b, 0, 1.0, h, md);
   }
 };
-// the scalar kernel tests' contact: G* 8 GPa, a 0.1 mm, N 100 N, mu 0.3
-constexpr double kG = 8e9, kA = 1e-4, kN = 100.0, kMu = 0.3;
+// the scalar kernel tests' contact: G* 8 GPa, a 0.1 mm, N 100 N, mu 0.3 (names of their own: CI's sanitizer
+// build compiles the tests as a unity build, where mindlin_deresiewicz_test.cpp's kG etc. share the scope)
+constexpr double kBlockG = 8e9, kBlockA = 1e-4, kBlockN = 100.0, kBlockMu = 0.3;
 }  // namespace
 
 TEST(MdBlockLaw, MonotonicLoadingAndAMasingCycleFollowTheClosedForms) {
-  const double ds = kernels::mdSlipDisplacement(kG, kA, kMu, kN), muN = kMu * kN;
+  const double ds = kernels::mdSlipDisplacement(kBlockG, kBlockA, kBlockMu, kBlockN), muN = kBlockMu * kBlockN;
   const int perDs = 20000;
   const double dd = ds / perDs;
   // monotonic loading: T = mu N [1 - (1 - d/ds)^(3/2)] up to ds, mu N beyond (Johnson 1985 eq. 7.40)
   {
-    BlockContact c(kG, kMu, kA, kN);
+    BlockContact c(kBlockG, kBlockMu, kBlockA, kBlockN);
     double maxErr = 0.0;
     for (int k = 1; k <= 3 * perDs / 2; ++k) {
-      const auto r = c.step(Vec3(dd, 0, 0), kA, kN);
+      const auto r = c.step(Vec3(dd, 0, 0), kBlockA, kBlockN);
       const double d = k * dd;
       if (d <= ds) maxErr = std::max(maxErr, std::abs(r.force.x() - muN * (1 - std::pow(1 - d / ds, 1.5))) / muN);
       if (d >= 1.05 * ds) {
@@ -204,22 +205,22 @@ TEST(MdBlockLaw, MonotonicLoadingAndAMasingCycleFollowTheClosedForms) {
   // a cycle of amplitude d* = 0.5 ds after loading to d*: the loop area and the ledger's dissipation equal
   // 9 (mu N)^2/(10 a G*) [1 - (1-q)^(5/3) - (5q/6)(1 + (1-q)^(2/3))], q = T*/(mu N) (Johnson 1985 eq. 7.60)
   {
-    BlockContact c(kG, kMu, kA, kN);
+    BlockContact c(kBlockG, kBlockMu, kBlockA, kBlockN);
     const int n = perDs / 2;
-    for (int k = 0; k < n; ++k) c.step(Vec3(dd, 0, 0), kA, kN);
+    for (int k = 0; k < n; ++k) c.step(Vec3(dd, 0, 0), kBlockA, kBlockN);
     const double q = 1 - std::pow(0.5, 1.5);  // T*/(mu N) at d* = ds/2
     double area = 0.0, dissipated = 0.0;
     for (int cycle = 0; cycle < 2; ++cycle)
       for (int half = 0; half < 2; ++half)
         for (int k = 0; k < 2 * n; ++k) {
           const double sign = half == 0 ? -1.0 : 1.0, before = c.h.tangentialForce.x();
-          const auto r = c.step(Vec3(sign * dd, 0, 0), kA, kN);
+          const auto r = c.step(Vec3(sign * dd, 0, 0), kBlockA, kBlockN);
           if (cycle == 1) {
             area += 0.5 * (before + r.force.x()) * sign * dd;
             dissipated += r.dissipated;
           }
         }
-    const double closed = 9 * muN * muN / (10 * kA * kG) *
+    const double closed = 9 * muN * muN / (10 * kBlockA * kBlockG) *
                           (1 - std::pow(1 - q, 5.0 / 3.0) - 5 * q / 6 * (1 + std::pow(1 - q, 2.0 / 3.0)));
     std::printf("block law, cycle d* = ds/2: loop area %.6e J, closed form %.6e J, ledger %.6e J\n", area, closed,
                 dissipated);
