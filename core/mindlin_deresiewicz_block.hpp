@@ -27,9 +27,10 @@ namespace fl::kernels {
 // {0} ∪ [2^-53, 1] (1 - a ratio, clamped). A first guess of x^(-1/3) from the exponent bits (the integer
 // division of the bit pattern by 3, as in Kahan's cube root, taken in double: AVX-512 has no 64-bit integer
 // division), three Newton steps for the reciprocal cube root r <- r (4 - x r^3)/3 (quadratic: 3.4e-2 ->
-// ~1e-3 -> ~1e-6 -> ~1e-12), y = x r^2 and one Newton step on y (r^2 standing for 1/y^2). Within 3 ulp of
-// libm's cbrt on [2^-100, 1] (tests/mindlin_deresiewicz_block_test.cpp); exact at 0 and 1, so a contact
-// without micro-slip keeps the stiffness 8 G* a exactly. ~0.7 ns a value vectorised against ~13 ns for libm.
+// ~1e-3 -> ~1e-6 -> ~1e-12), y = x r^2 and one Newton step on y (r^2 standing for 1/y^2). Within 4 ulp of
+// libm's cbrt on [2^-100, 1] (3 or 4 by how the compiler contracts into FMAs;
+// tests/mindlin_deresiewicz_block_test.cpp); exact at 0 and 1, so a contact without micro-slip keeps the
+// stiffness 8 G* a exactly. ~0.7 ns a value vectorised against ~13 ns for libm.
 inline double cbrtUnit(double x) {
   const auto bits = std::bit_cast<std::int64_t>(x);
   double r = std::bit_cast<double>(std::int64_t{0x553EF00000000000} -

