@@ -41,7 +41,7 @@ struct alignas(64) PairBlock {
   alignas(64) double vx[kBlockPairs], vy[kBlockPairs], vz[kBlockPairs];  // v_j - v_i (+ L d) [m/s]
   alignas(64) double wix[kBlockPairs], wiy[kBlockPairs], wiz[kBlockPairs];  // omega_i [rad/s]
   alignas(64) double wjx[kBlockPairs], wjy[kBlockPairs], wjz[kBlockPairs];  // omega_j [rad/s]
-  alignas(64) double invMassSum[kBlockPairs];  // 1/m_i + 1/m_j [1/kg], read only with damping (and mdBlockSums)
+  alignas(64) double invMassSum[kBlockPairs];  // 1/m_i + 1/m_j [1/kg], read only with damping (and mdBlockMeasures)
   alignas(64) double effYoung[kBlockPairs], effShear[kBlockPairs];       // E*, G* [Pa]
   alignas(64) double friction[kBlockPairs], dampingRatio[kBlockPairs];   // mu, beta [-]
   // ---- history: in and out (ContactHistory)

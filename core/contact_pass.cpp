@@ -16,7 +16,6 @@
 
 #include "contact_block.hpp"
 #include "contact_kernels.hpp"
-#include "mindlin_deresiewicz.hpp"
 #include "mindlin_deresiewicz_block.hpp"
 #include "simulation.hpp"
 #include "streaming_store.hpp"
