@@ -9,6 +9,8 @@ std::size_t ContactStore::activeCount() const {
 }
 
 void ContactStore::resizeResults() {
+  result.clear();
+  fitCapacity(result, size());  // reused by each rebuild (huge_pages.hpp)
   result.assign(size(), PairResult{});
 }
 
@@ -20,18 +22,23 @@ void ContactStore::markTouched() {
 }
 
 void ContactStore::buildAdjacency(std::size_t particleCount) {
+  // counted, summed, then filled with adjStart as the cursor and shifted back: no array beside the store's (a
+  // rebuild touches no fresh memory, docs/performance.md, fortieth session)
   adjStart.assign(particleCount + 1, 0);
   for (std::size_t p = 0; p < size(); ++p) {
     ++adjStart[first[p] + 1];
     ++adjStart[second[p] + 1];
   }
   for (std::size_t k = 0; k < particleCount; ++k) adjStart[k + 1] += adjStart[k];
+  adjEntry.clear();
+  fitCapacity(adjEntry, 2 * size());
   adjEntry.resize(2 * size());
-  std::vector<std::int32_t> fill(adjStart.begin(), adjStart.end() - 1);
   for (std::size_t p = 0; p < size(); ++p) {
-    adjEntry[fill[first[p]]++] = static_cast<std::int32_t>(p << 1);
-    adjEntry[fill[second[p]]++] = static_cast<std::int32_t>((p << 1) | 1);
+    adjEntry[adjStart[first[p]]++] = static_cast<std::int32_t>(p << 1);
+    adjEntry[adjStart[second[p]]++] = static_cast<std::int32_t>((p << 1) | 1);
   }
+  for (std::size_t k = particleCount; k > 0; --k) adjStart[k] = adjStart[k - 1];
+  adjStart[0] = 0;
 }
 
 }  // namespace fl

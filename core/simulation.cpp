@@ -8,6 +8,7 @@
 
 
 #include "errors.hpp"
+#include "history_carry.hpp"
 #include "neighbor_search.hpp"
 
 namespace fl {
@@ -297,45 +298,49 @@ void Simulation::rebuildNeighbours() {
       m_p.vel[i] = m_pass[i].v;
     }
   }
-  // keys of the old pairs that carry history, with the image counters before wrapping
-  struct OldKey {
-    std::int32_t i, j;
-    Vec3i key;
-    std::size_t index;
-  };
-  std::vector<OldKey> old;
-  for (std::size_t p = 0; p < m_c.size(); ++p) {
-    if (m_c.history[p].tangentialForce.squaredNorm() == 0.0 && m_c.history[p].contactRadius == 0.0) continue;
-    const int i = m_c.first[p], j = m_c.second[p];
-    old.push_back({i, j, m_c.image[p].vec() - m_p.image[j] + m_p.image[i], p});
-  }
+  // the list being replaced steps aside (its pairs; the history stays, to be carried over in place), and the new
+  // list is written into the arrays of the list before it: a rebuild writes no fresh memory (huge_pages.hpp)
+  m_oldPairs.first.swap(m_c.first);
+  m_oldPairs.second.swap(m_c.second);
+  m_oldPairs.image.swap(m_c.image);
+  m_imageBeforeWrap = m_p.image;  // the old pairs' keys are of the image counters before wrapping
   // wrap into the cell
   for (std::size_t i = 0; i < n; ++i) m_p.image[i] += m_cell.wrap(m_p.pos[i]);
-  PairList L = findPairs(m_p, m_cell, m_skin, m_num.threads, &m_team);
-  ContactStore next;
-  next.first = std::move(L.first);
-  next.second = std::move(L.second);
-  next.image = std::move(L.image);
-  next.history.assign(next.size(), ContactHistory{});
-  const bool md = m_num.tangentialModel == TangentialModel::MindlinDeresiewicz;
-  if (md) next.mdHistory.assign(next.size(), MdHistory{});
-  // carry history over by key: both lists are sorted by (i, j)
-  std::size_t q = 0;
-  for (std::size_t p = 0; p < next.size() && q < old.size(); ++p) {
-    const int i = next.first[p], j = next.second[p];
-    while (q < old.size() && (old[q].i < i || (old[q].i == i && old[q].j < j))) ++q;
-    for (std::size_t r = q; r < old.size() && old[r].i == i && old[r].j == j; ++r) {
-      const Vec3i key = next.image[p].vec() - m_p.image[j] + m_p.image[i];
-      if (key == old[r].key) {
-        next.history[p] = m_c.history[old[r].index];
-        if (md) next.mdHistory[p] = m_c.mdHistory[old[r].index];
-        break;
-      }
-    }
+  {
+    PairList L;
+    L.first.swap(m_c.first);
+    L.second.swap(m_c.second);
+    L.image.swap(m_c.image);
+    findPairs(m_p, m_cell, m_skin, m_num.threads, &m_team, m_grid, L);
+    m_c.first.swap(L.first);
+    m_c.second.swap(L.second);
+    m_c.image.swap(L.image);
+    fitCapacity(m_c.first, m_c.size());  // after a list that grew by more than the room left (the first)
+    fitCapacity(m_c.second, m_c.size());
+    fitCapacity(m_c.image, m_c.size());
   }
+  ContactStore& next = m_c;
+  // the history carried over by key, inside its array (history_carry.hpp)
+  matchHistory({m_oldPairs.first, m_oldPairs.second, m_oldPairs.image, m_imageBeforeWrap}, next.history,
+               {next.first, next.second, next.image, m_p.image}, m_historyMatch);
+  moveHistory(next.history, m_historyMatch);
+  if (m_num.tangentialModel == TangentialModel::MindlinDeresiewicz) {
+    if (next.mdHistory.empty()) next.mdHistory.assign(m_oldPairs.first.size(), MdHistory{});
+    moveHistory(next.mdHistory, m_historyMatch);
+  } else {
+    next.mdHistory.clear();
+  }
+  next.touched.clear();  // the new list's are made by the first pass that wants them (contact_store.hpp)
+  next.touchedValid = false;
   next.resizeResults();
   next.buildAdjacency(n);
-  m_c = std::move(next);
+  // the old list's arrays are ready for the next list (written once now, when they are first made or resized)
+  m_oldPairs.first.clear();
+  m_oldPairs.second.clear();
+  m_oldPairs.image.clear();
+  fitCapacity(m_oldPairs.first, next.size());
+  fitCapacity(m_oldPairs.second, next.size());
+  fitCapacity(m_oldPairs.image, next.size());
   m_refPos = m_p.pos;
   m_refHinv = m_cell.inverse();
   m_maxDisp2 = 0.0;
@@ -573,7 +578,8 @@ std::size_t Simulation::memoryBytes() const {
          b(c.history) + b(c.mdHistory) + b(c.result) + b(c.adjStart) + b(c.adjEntry) + b(m_refPos) +
          b(m_pass) + b(m_chunks) + b(m_kickWork) + b(m_haloPass) + b(m_haloW) + b(m_seeds) +
          b(m_boundary.partner) + b(m_boundary.halo) + b(m_boundary.seedParticle) + b(m_boundary.seedOf) +
-         b(m_boundary.kickBegin) + b(m_boundary.seeded) + b(m_boundary.haloPairs);
+         b(m_boundary.kickBegin) + b(m_boundary.seeded) + b(m_boundary.haloPairs) + b(m_oldPairs.first) +
+         b(m_oldPairs.second) + b(m_oldPairs.image) + b(m_historyMatch) + b(m_imageBeforeWrap) + m_grid.bytes();
 }
 
 // ---- measures -----------------------------------------------------------------------------------

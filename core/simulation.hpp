@@ -30,6 +30,7 @@
 #include "contact_store.hpp"
 #include "energy_ledger.hpp"
 #include "material.hpp"
+#include "neighbor_search.hpp"
 #include "numerics.hpp"
 #include "particle_store.hpp"
 #include "periodic_cell.hpp"
@@ -248,6 +249,14 @@ class Simulation {
   HugeVector<Vec3> m_refPos;  // positions at the last rebuild
   Mat3 m_refHinv;              // H^-1 at the last rebuild
   double m_maxDisp2 = 0.0;     // max |x - F x_ref|^2 after the last drift
+  // The pairs of the list being replaced, set aside during a rebuild for the history's carry-over; between
+  // rebuilds these arrays keep their capacity, and the next rebuild's list is written into them. With the history
+  // moved in place and the grid's scratch kept, a rebuild writes no fresh memory (a fresh page costs ~1.6 ms a MB
+  // on the VMs we measure on: docs/performance.md, fortieth session).
+  PairList m_oldPairs;
+  HugeVector<std::uint32_t> m_historyMatch;  // history_carry.hpp
+  std::vector<Vec3i> m_imageBeforeWrap;      // the particles' image counters before the rebuild wraps them
+  GridScratch m_grid;
 
   Mat3 m_stress = Mat3::Zero();
   Mat3 m_stressPrev = Mat3::Zero();

@@ -91,3 +91,26 @@ TEST(HugePages, AVectorKeepsItsValuesThroughGrowthCopiesMovesAndShrinking) {
   v.shrink_to_fit();
   EXPECT_EQ(v.capacity(), 0u);
 }
+
+// fitCapacity: the arrays a rebuild writes again keep their memory while it fits, and are made again otherwise.
+TEST(HugePages, FitCapacityKeepsAFittingArrayAndRemakesOthersWithTheirFirstValues) {
+  HugeVector<std::int32_t> v;
+  fitCapacity(v, 1000);  // empty: made with room for 1000 + 1000/16 + 64
+  EXPECT_EQ(v.size(), 0u);
+  EXPECT_EQ(v.capacity(), 1000u + 62u + 64u);
+  for (int k = 0; k < 1000; ++k) v.push_back(k);
+  const std::int32_t* kept = v.data();
+  fitCapacity(v, 1100);  // still in [n, n + n/4 + 64]: the same memory, the values untouched
+  fitCapacity(v, 900);
+  EXPECT_EQ(v.data(), kept);
+  EXPECT_EQ(v.size(), 1000u);
+  fitCapacity(v, 2000);  // too small for 2000: remade, the values kept
+  EXPECT_GE(v.capacity(), 2000u);
+  EXPECT_LE(v.capacity(), 2000u + 2000u / 4 + 64u);
+  ASSERT_EQ(v.size(), 1000u);
+  for (int k = 0; k < 1000; ++k) ASSERT_EQ(v[k], k);
+  fitCapacity(v, 100);  // far too large for 100: remade, the first 100 values kept
+  EXPECT_LE(v.capacity(), 100u + 100u / 4 + 64u);
+  ASSERT_EQ(v.size(), 100u);
+  for (int k = 0; k < 100; ++k) ASSERT_EQ(v[k], k);
+}

@@ -2,6 +2,7 @@
 // orthorhombic and sheared cells; too small a cell is a clear error.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
 #include <tuple>
 
@@ -67,5 +68,37 @@ TEST(NeighbourSearch, TooSmallACellIsAClearError) {
     FAIL() << "expected CellTooSmallError";
   } catch (const CellTooSmallError& e) {
     EXPECT_NE(std::string(e.what()).find("too small"), std::string::npos);
+  }
+}
+
+// The grid's list is the brute force's sorted by (i, j), entry for entry, on any thread count; the form that
+// reuses its output and scratch gives the same list on a second packing (a shorter and then a longer list).
+TEST(NeighbourSearch, GridListIsTheSortedBruteForceOnAnyThreadCountWithReusedArrays) {
+  GridScratch scratch;
+  PairList reused;
+  for (double fraction : {0.3, 0.15, 0.35}) {
+    GasSpec g;
+    g.count = 700;
+    g.solidFraction = fraction;
+    g.seed = 11;
+    Packing pk = generateGas(g);
+    const double skin = 0.15e-3;
+    PairList brute = findPairsBruteForce(pk.particles, pk.cell, skin);
+    std::vector<std::tuple<int, int, int, int, int>> sorted;
+    for (std::size_t k = 0; k < brute.first.size(); ++k)
+      sorted.emplace_back(brute.first[k], brute.second[k], brute.image[k].x, brute.image[k].y, brute.image[k].z);
+    std::sort(sorted.begin(), sorted.end());
+    const auto entries = [](const PairList& L) {
+      std::vector<std::tuple<int, int, int, int, int>> e;
+      for (std::size_t k = 0; k < L.first.size(); ++k)
+        e.emplace_back(L.first[k], L.second[k], L.image[k].x, L.image[k].y, L.image[k].z);
+      return e;
+    };
+    for (int threads : {1, 2, 3}) {
+      EXPECT_EQ(entries(findPairsGrid(pk.particles, pk.cell, skin, threads)), sorted)
+          << "solid fraction " << fraction << ", " << threads << " threads";
+      findPairs(pk.particles, pk.cell, skin, threads, nullptr, scratch, reused);
+      EXPECT_EQ(entries(reused), sorted) << "reused arrays, solid fraction " << fraction << ", " << threads << " threads";
+    }
   }
 }

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
 
 #include "core/binary_io.hpp"
 #include "core/neighbor_search.hpp"
@@ -147,6 +148,30 @@ TEST(VerletSkin, AFixedSkinStaysFixed) {
   sim.run(5000);
   ASSERT_GT(sim.profile().rebuilds, 0);
   EXPECT_EQ(sim.skin(), 0.07e-3);
+}
+
+// A rebuild writes the new list into the arrays it has (core/huge_pages.hpp: fitCapacity; docs/performance.md,
+// fortieth session): once the list's length has settled (within a few per cent), the pass's results and the
+// history stay where they are, and the pair definitions take turns in two sets of arrays.
+TEST(VerletSkin, RebuildsReuseTheirArrays) {
+  Simulation sim = quietingPacking(2, 0.02e-3);
+  sim.run(1500);
+  const long before = sim.profile().rebuilds;
+  const ContactStore& c = sim.contacts();
+  const PairResult* results = c.result.data();
+  const ContactHistory* history = c.history.data();
+  const std::size_t pairs = c.size();
+  std::set<const std::int32_t*> firsts{c.first.data()};
+  for (int k = 0; k < 20; ++k) {  // at every check: fresh arrays would alternate between addresses at best
+    sim.run(100);
+    ASSERT_NEAR(static_cast<double>(c.size()), static_cast<double>(pairs), 0.05 * pairs);
+    EXPECT_EQ(c.result.data(), results) << "after " << (k + 1) * 100 << " steps";
+    EXPECT_EQ(c.history.data(), history) << "after " << (k + 1) * 100 << " steps";
+    firsts.insert(c.first.data());
+  }
+  ASSERT_GE(sim.profile().rebuilds, before + 10) << "the run must cross rebuilds";
+  EXPECT_EQ(firsts.size(), 2u);
+  EXPECT_EQ(c.activeCount(), touchingByBruteForce(sim));
 }
 
 TEST(VerletSkin, SameBitsForAnyThreadCountAndAcrossACheckpoint) {
