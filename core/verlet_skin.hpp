@@ -8,7 +8,9 @@
 //     a loose gas's ≈ 24 φ/d, ten times fewer);
 //   - the rebuilds: one costs as much per particle as ρ such pairs for one step (ρ ≈ 100 measured on the dense
 //     benchmark, 0.75 µs a particle against 7.3 ns a pair; 150 here for what follows a rebuild: fresh arrays,
-//     cold caches, the threads' shares made again), once every s / ů steps, ů = u(n)/n.
+//     cold caches, the threads' shares made again), once every s / ů steps, ů = u(n)/n. Since the fortieth
+//     session a rebuild reuses its arrays and costs ~0.33 µs a particle (ρ ≈ 45 before what follows it); ρ is
+//     kept at 150 until a smaller one is measured to pay: it would change every run's lists and results.
 // Per step and particle, in pair-steps: ρ ů / s + g s; the minimum is at s* = sqrt(ρ ů / g). g is read off the
 // list being replaced, (listed − touching pairs) / (particles s): the packing's own density of gaps, so a gas
 // gets a wider skin than a dense packing moving as fast. The optimum is flat (a factor 2 in s costs 25 % more
