@@ -151,25 +151,29 @@ TEST(VerletSkin, AFixedSkinStaysFixed) {
 }
 
 // A rebuild writes the new list into the arrays it has (core/huge_pages.hpp: fitCapacity; docs/performance.md,
-// fortieth session): once the list's length has settled (within a few per cent), the pass's results and the
-// history stay where they are, and the pair definitions take turns in two sets of arrays.
+// fortieth session). Rebuilt again and again on the same positions (refresh(): the same list each time), the
+// pass's results and the history stay where they are, and the pair definitions take turns in two sets of arrays
+// (the history's carry-over itself: tests/history_carry_test.cpp). Over a moving run the list's length drifts,
+// and a refit is right when it leaves the kept range: that depends on the trajectory, which differs between
+// compilers, so the test does not move the particles.
 TEST(VerletSkin, RebuildsReuseTheirArrays) {
   Simulation sim = quietingPacking(2, 0.02e-3);
-  sim.run(1500);
-  const long before = sim.profile().rebuilds;
+  sim.run(500);
+  sim.refresh();  // a first rebuild may refit arrays sized for an earlier, longer list
+  sim.refresh();
   const ContactStore& c = sim.contacts();
   const PairResult* results = c.result.data();
   const ContactHistory* history = c.history.data();
   const std::size_t pairs = c.size();
+  ASSERT_GT(pairs, 500u);
   std::set<const std::int32_t*> firsts{c.first.data()};
-  for (int k = 0; k < 20; ++k) {  // at every check: fresh arrays would alternate between addresses at best
-    sim.run(100);
-    ASSERT_NEAR(static_cast<double>(c.size()), static_cast<double>(pairs), 0.05 * pairs);
-    EXPECT_EQ(c.result.data(), results) << "after " << (k + 1) * 100 << " steps";
-    EXPECT_EQ(c.history.data(), history) << "after " << (k + 1) * 100 << " steps";
+  for (int k = 0; k < 6; ++k) {
+    sim.refresh();
+    ASSERT_EQ(c.size(), pairs);
+    EXPECT_EQ(c.result.data(), results) << "after refresh " << k;
+    EXPECT_EQ(c.history.data(), history) << "after refresh " << k;
     firsts.insert(c.first.data());
   }
-  ASSERT_GE(sim.profile().rebuilds, before + 10) << "the run must cross rebuilds";
   EXPECT_EQ(firsts.size(), 2u);
   EXPECT_EQ(c.activeCount(), touchingByBruteForce(sim));
 }
