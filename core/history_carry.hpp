@@ -9,6 +9,7 @@
 // array, and writes no fresh memory (huge_pages.hpp: fitCapacity; docs/performance.md, fortieth session).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
