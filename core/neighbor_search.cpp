@@ -115,7 +115,9 @@ void findPairsGrid(const ParticleStore& p, const PeriodicCell& cell, double skin
   out.first.clear();
   out.second.clear();
   out.image.clear();
+  int used = 1;  // the threads the loop ran on: OpenMP may give fewer than asked (a nested region gets one)
   const auto search = [&](int t, int nt) {
+    if (t == 0) used = nt;
     PairList& dst = t == 0 ? out : s.threadPairs[t];
     if (t > 0) {
       dst.first.clear();
@@ -181,7 +183,7 @@ void findPairsGrid(const ParticleStore& p, const PeriodicCell& cell, double skin
   };
   ThreadTeam forked;  // not held: each() forks
   (team != nullptr ? *team : forked).each(threads, search);
-  for (int t = 1; t < most; ++t) {
+  for (int t = 1; t < used; ++t) {  // not `most`: a thread that did not run left an earlier call's pairs there
     const PairList& part = s.threadPairs[t];
     out.first.insert(out.first.end(), part.first.begin(), part.first.end());
     out.second.insert(out.second.end(), part.second.begin(), part.second.end());

@@ -102,3 +102,25 @@ TEST(NeighbourSearch, GridListIsTheSortedBruteForceOnAnyThreadCountWithReusedArr
     }
   }
 }
+
+// When OpenMP runs the search on fewer threads than asked (here a region nested in another gets one), only the
+// threads that ran give pairs: the scratch of an earlier 2-thread call must not be joined again.
+TEST(NeighbourSearch, FewerThreadsThanAskedJoinOnlyTheThreadsThatRan) {
+  GasSpec g;
+  g.count = 700;
+  g.solidFraction = 0.3;
+  Packing pk = generateGas(g);
+  const double skin = 0.15e-3;
+  const PairList expected = findPairsGrid(pk.particles, pk.cell, skin, 1);
+  GridScratch scratch;
+  PairList out;
+  findPairs(pk.particles, pk.cell, skin, 2, nullptr, scratch, out);  // fills the second thread's scratch
+  ASSERT_EQ(out.first.size(), expected.first.size());
+#pragma omp parallel num_threads(2)
+  {
+#pragma omp single
+    findPairs(pk.particles, pk.cell, skin, 2, nullptr, scratch, out);  // nested: one thread
+  }
+  EXPECT_EQ(out.first, expected.first);
+  EXPECT_EQ(out.second, expected.second);
+}
