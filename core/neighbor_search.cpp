@@ -199,21 +199,20 @@ PairList findPairsGrid(const ParticleStore& p, const PeriodicCell& cell, double 
   return L;
 }
 
-PairList findPairs(const ParticleStore& p, const PeriodicCell& cell, double skin, int threads, ThreadTeam* team) {
-  const double cutoff = 2.0 * p.maxRadius() + skin;
-  const Vec3 w = cell.perpendicularWidths();
-  if ((w / cutoff).minCoeff() >= 3.0) return findPairsGrid(p, cell, skin, threads, team);
-  PairList L = findPairsBruteForce(p, cell, skin);
-  sortPairs(L);
-  return L;
-}
-
 void findPairs(const ParticleStore& p, const PeriodicCell& cell, double skin, int threads, ThreadTeam* team,
                GridScratch& scratch, PairList& out) {
   const double cutoff = 2.0 * p.maxRadius() + skin;
   const Vec3 w = cell.perpendicularWidths();
   if ((w / cutoff).minCoeff() >= 3.0) return findPairsGrid(p, cell, skin, threads, team, scratch, out);
-  out = findPairs(p, cell, skin, threads, team);  // a cell too small for the grid: a few particles
+  out = findPairsBruteForce(p, cell, skin);  // a cell too small for the grid: a few particles
+  sortPairs(out);
+}
+
+PairList findPairs(const ParticleStore& p, const PeriodicCell& cell, double skin, int threads, ThreadTeam* team) {
+  GridScratch scratch;
+  PairList L;
+  findPairs(p, cell, skin, threads, team, scratch, L);
+  return L;
 }
 
 }  // namespace fl

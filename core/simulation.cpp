@@ -319,28 +319,27 @@ void Simulation::rebuildNeighbours() {
     fitCapacity(m_c.second, m_c.size());
     fitCapacity(m_c.image, m_c.size());
   }
-  ContactStore& next = m_c;
   // the history carried over by key, inside its array (history_carry.hpp)
-  matchHistory({m_oldPairs.first, m_oldPairs.second, m_oldPairs.image, m_imageBeforeWrap}, next.history,
-               {next.first, next.second, next.image, m_p.image}, m_historyMatch);
-  moveHistory(next.history, m_historyMatch);
+  matchHistory({m_oldPairs.first, m_oldPairs.second, m_oldPairs.image, m_imageBeforeWrap}, m_c.history,
+               {m_c.first, m_c.second, m_c.image, m_p.image}, m_historyMatch);
+  moveHistory(m_c.history, m_historyMatch);
   if (m_num.tangentialModel == TangentialModel::MindlinDeresiewicz) {
-    if (next.mdHistory.empty()) next.mdHistory.assign(m_oldPairs.first.size(), MdHistory{});
-    moveHistory(next.mdHistory, m_historyMatch);
+    if (m_c.mdHistory.empty()) m_c.mdHistory.assign(m_oldPairs.first.size(), MdHistory{});
+    moveHistory(m_c.mdHistory, m_historyMatch);
   } else {
-    next.mdHistory.clear();
+    m_c.mdHistory.clear();
   }
-  next.touched.clear();  // the new list's are made by the first pass that wants them (contact_store.hpp)
-  next.touchedValid = false;
-  next.resizeResults();
-  next.buildAdjacency(n);
+  m_c.touched.clear();  // the new list's are made by the first pass that wants them (contact_store.hpp)
+  m_c.touchedValid = false;
+  m_c.resizeResults();
+  m_c.buildAdjacency(n);
   // the old list's arrays are ready for the next list (written once now, when they are first made or resized)
   m_oldPairs.first.clear();
   m_oldPairs.second.clear();
   m_oldPairs.image.clear();
-  fitCapacity(m_oldPairs.first, next.size());
-  fitCapacity(m_oldPairs.second, next.size());
-  fitCapacity(m_oldPairs.image, next.size());
+  fitCapacity(m_oldPairs.first, m_c.size());
+  fitCapacity(m_oldPairs.second, m_c.size());
+  fitCapacity(m_oldPairs.image, m_c.size());
   m_refPos = m_p.pos;
   m_refHinv = m_cell.inverse();
   m_maxDisp2 = 0.0;
