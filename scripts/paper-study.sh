@@ -4,7 +4,7 @@
 # lists all its stages is skipped). A step that nothing else can run beside (a specimen, the anisotropic
 # history) takes JOBS threads; the others run JOBS at a time, one thread each. Results do not depend on the
 # thread count (the same bits, tests/determinism_test.cpp).
-# Usage: scripts/paper-study.sh [JOBS]       (16 min on 2 AMD EPYC cores, 21-23 min on Zen 4 before the M–D law was vectorised; docs/performance.md)
+# Usage: scripts/paper-study.sh [JOBS]       (14 min on 2 AMD EPYC cores, 21-23 min on Zen 4 before the M–D law was vectorised; docs/performance.md)
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 jobs="${1:-$(nproc)}"
