@@ -11,8 +11,9 @@
 # team size, each thread's microseconds per step in each slot. The engine in the tree is never changed.
 # Switches of the patched build: FL_PROBE_BAL=1 logs each window of the share balance (its costs and best edge),
 # FL_FORCE_HALO=1 runs the pass's halo template on one thread, FL_NO_STEAL=1 takes no runs in a seeded pass.
-# The patch was made against the engine of the thirtieth session (c061aa0); once the engine moves on it may no
-# longer apply: the script then says so and stops, and the patch is to be made again from its description.
+# The patch was made against the engine of the thirtieth session (c061aa0) and made again in the forty-second (the
+# seeds' sum from ThreadBoundary::seedEntry); once the engine moves on it may no longer apply: the script then says
+# so and stops, and the patch is to be made again from its description.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 dir="$root/build/probe"
@@ -21,7 +22,7 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --build) dir="$2"; shift 2 ;;
     --) shift; args=("$@"); break ;;
-    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
     *) echo "step_probe.sh: unknown option $1 (bench_dense's arguments go after --)" >&2; exit 2 ;;
   esac
 done

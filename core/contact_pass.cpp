@@ -231,12 +231,15 @@ void Simulation::contactPassBlocked() {
         taking = true;
         if (exchange) {
           runs.waitForTakers();
+          const std::int32_t* seedEntry = tb.seedEntry.data();
+          const std::int32_t* seedEntryBegin = tb.seedEntryBegin.data();
+          const std::int32_t eEnd = seedEntryBegin[tb.seedBegin[t + 1]];
           for (std::size_t q = tb.seedBegin[t]; q < tb.seedBegin[t + 1]; ++q) {
-            const std::int32_t i = tb.seedParticle[q];
-            const double ri = m_p.radius[i];  // not pass[i]: its owner's line
+            const double ri = m_p.radius[tb.seedParticle[q]];  // not the pass copy: its owner's line
             double fx = 0.0, fy = 0.0, fz = 0.0, tx = 0.0, ty = 0.0, tz = 0.0;
-            for (std::int32_t e = m_c.adjStart[i]; e < tb.kickBegin[i]; ++e) {
-              const std::int32_t entry = m_c.adjEntry[e];
+            for (std::int32_t e = seedEntryBegin[q]; e < seedEntryBegin[q + 1]; ++e) {
+              if (e + kSeedAhead < eEnd) __builtin_prefetch(arr.result + (seedEntry[e + kSeedAhead] >> 1));
+              const std::int32_t entry = seedEntry[e];
               kickEntry(arr.result[entry >> 1], entry, ri, fx, fy, fz, tx, ty, tz);
             }
             seeds[q] = {fx, fy, fz, tx, ty, tz};

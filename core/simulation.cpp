@@ -577,7 +577,8 @@ std::size_t Simulation::memoryBytes() const {
          b(c.history) + b(c.mdHistory) + b(c.result) + b(c.adjStart) + b(c.adjEntry) + b(m_refPos) +
          b(m_pass) + b(m_chunks) + b(m_kickWork) + b(m_haloPass) + b(m_haloW) + b(m_seeds) +
          b(m_boundary.partner) + b(m_boundary.halo) + b(m_boundary.seedParticle) + b(m_boundary.seedOf) +
-         b(m_boundary.kickBegin) + b(m_boundary.seeded) + b(m_boundary.haloPairs) + b(m_oldPairs.first) +
+         b(m_boundary.kickBegin) + b(m_boundary.seeded) + b(m_boundary.seedEntry) +
+         b(m_boundary.seedEntryBegin) + b(m_boundary.haloPairs) + b(m_oldPairs.first) +
          b(m_oldPairs.second) + b(m_oldPairs.image) + b(m_historyMatch) + b(m_imageBeforeWrap) + m_grid.bytes();
 }
 

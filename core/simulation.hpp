@@ -280,6 +280,8 @@ class Simulation {
   // pairs outside the thread's own share of the pass (another core most likely wrote them), or all from
   // kLargeStateFrom particles: with one thread at 4000 spheres, prefetching every entry cost 2-7 % of a step.
   static constexpr int kPrefetchEntries = 140;
+  // How far ahead (entries of ThreadBoundary::seedEntry, ~8 seeds) the seeds' sum prefetches the result lines.
+  static constexpr int kSeedAhead = 16;
   // How far ahead (listed pairs, ~40 particles) the contact pass prefetches each partner's pass line and omega
   // when the state outgrows the caches: one pair's prefetch per pair computed, spread through the block's
   // geometry loop. The same prefetches issued as a burst of 128 per block of 64 pairs left the step 6 % slower

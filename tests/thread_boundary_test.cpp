@@ -84,10 +84,17 @@ void checkBoundary(const ContactStore& c, std::size_t n, int nt, const std::vect
     EXPECT_GE(s, b.seedBegin[t]);
     EXPECT_LT(s, b.seedBegin[t + 1]);
     for (std::int32_t e = e0; e < k; ++e) EXPECT_EQ(by(c.adjEntry[e]), t) << "particle " << i;
+    // the seed's sum walks its own copy of those entries, in the same order
+    ASSERT_EQ(b.seedEntryBegin[s + 1] - b.seedEntryBegin[s], k - e0) << "particle " << i;
+    for (std::int32_t e = e0; e < k; ++e)
+      EXPECT_EQ(b.seedEntry[static_cast<std::size_t>(b.seedEntryBegin[s] + (e - e0))], c.adjEntry[e]) << "particle " << i;
     for (std::int32_t e = k; e < e1; ++e) EXPECT_EQ(by(c.adjEntry[e]), owner[i]) << "particle " << i;
   }
   EXPECT_GT(seeded, 0u);
   EXPECT_EQ(seeded + 1, b.seedParticle.size());
+  ASSERT_EQ(b.seedEntryBegin.size(), b.seedParticle.size() + 1);
+  EXPECT_EQ(b.seedEntryBegin[0], b.seedEntryBegin[1]) << "the zero seed sums nothing";
+  EXPECT_EQ(static_cast<std::size_t>(b.seedEntryBegin.back()), b.seedEntry.size());
   // the kick's list of seeded particles: every one, ascending, then an index past every particle
   ASSERT_EQ(b.seeded.size(), seeded + 1);
   for (std::size_t q = 0; q + 1 < b.seeded.size(); ++q) {
