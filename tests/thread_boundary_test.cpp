@@ -65,6 +65,7 @@ void checkBoundary(const ContactStore& c, std::size_t n, int nt, const std::vect
   EXPECT_EQ(b.halo.size(), readCount) << "a slot no other thread reads";
   EXPECT_GT(b.halo.size(), 0u);
   // seeds: the leading entries of one other thread, and nothing of another after them
+  ASSERT_EQ(b.seedEntryBegin.size(), b.seedParticle.size() + 1);  // each slot's entries, and the zero seed's
   std::size_t seeded = 0, foreignUnseeded = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const std::int32_t e0 = c.adjStart[i], e1 = c.adjStart[i + 1], k = b.kickBegin[i];
@@ -92,7 +93,6 @@ void checkBoundary(const ContactStore& c, std::size_t n, int nt, const std::vect
   }
   EXPECT_GT(seeded, 0u);
   EXPECT_EQ(seeded + 1, b.seedParticle.size());
-  ASSERT_EQ(b.seedEntryBegin.size(), b.seedParticle.size() + 1);
   EXPECT_EQ(b.seedEntryBegin[0], b.seedEntryBegin[1]) << "the zero seed sums nothing";
   EXPECT_EQ(static_cast<std::size_t>(b.seedEntryBegin.back()), b.seedEntry.size());
   // the kick's list of seeded particles: every one, ascending, then an index past every particle
