@@ -92,20 +92,17 @@ ThreadBoundary buildThreadBoundary(const ContactStore& c, std::size_t particleCo
     seeds[by].push_back(static_cast<std::int32_t>(i));
     b.kickBegin[i] = e;
   }
+  b.seedEntryBegin.assign(2, 0);  // slot 0, the zero seed, sums nothing
   for (int t = 0; t < nt; ++t) {
     b.seedBegin[t] = b.seedParticle.size();
     for (const std::int32_t i : seeds[t]) {
       b.seedOf[i] = static_cast<std::int32_t>(b.seedParticle.size());
       b.seedParticle.push_back(i);
+      b.seedEntry.insert(b.seedEntry.end(), c.adjEntry.begin() + c.adjStart[i], c.adjEntry.begin() + b.kickBegin[i]);
+      b.seedEntryBegin.push_back(static_cast<std::int32_t>(b.seedEntry.size()));
     }
   }
   b.seedBegin[nt] = b.seedParticle.size();
-  b.seedEntryBegin.assign(2, 0);  // slot 0, the zero seed, sums nothing
-  for (std::size_t s = 1; s < b.seedParticle.size(); ++s) {
-    const std::int32_t i = b.seedParticle[s];
-    b.seedEntry.insert(b.seedEntry.end(), c.adjEntry.begin() + c.adjStart[i], c.adjEntry.begin() + b.kickBegin[i]);
-    b.seedEntryBegin.push_back(static_cast<std::int32_t>(b.seedEntry.size()));
-  }
   for (std::size_t i = 0; i < n; ++i)
     if (b.seedOf[i] != 0) b.seeded.push_back(static_cast<std::int32_t>(i));
   b.seeded.push_back(std::numeric_limits<std::int32_t>::max());
